@@ -1,0 +1,14 @@
+//! Density sources for planetary marching cubes.
+//!
+//! - [`Density`]: the small composable trait (one point, or a whole chunk in one batch call).
+//!   Positive density is solid, the surface is at zero.
+//! - [`noise`]: fractal 3D gradient noise in `f64`, sampled on the sphere (seed 000 Sec. 4.6).
+//! - [`presets`]: terrains with continents, mountains, seas, caves and overhangs.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+mod density;
+pub mod noise;
+pub mod presets;
+
+pub use density::{Density, FnDensity, Sphere, Subtract, Union};

@@ -1,0 +1,158 @@
+//! The sample grid of one chunk: voxel directions, layer radii and canonical keys, with one voxel
+//! of padding on every side.
+//!
+//! # Overlap and padding contract
+//!
+//! A chunk of `n = n_t` tiles per axis owns the `(n + 1)^3` voxels at its tile corners; it shares
+//! its border voxels with its neighbours (seed 000 Sec. 4.4: chunks overlap by their border
+//! voxels). Around them lies one layer of padding, used only for density gradients (normals): the
+//! grid is `(n + 3)^3` samples, local index `a` in `0..n + 3` standing for face grid index
+//! `i0 + (a - 1) stride`. Padding past a face edge is the neighbouring face's voxel (unfolded as in
+//! Algorithm 1). Past a cube corner, where neither face has a voxel, the padding column is marked
+//! invalid and never read by the mesher.
+
+use crate::face::Face;
+use crate::keys::{ChunkKey, VoxelKey};
+use crate::layout::Layout;
+use glam::{DVec3, IVec3};
+
+/// The sampling geometry of one chunk (see the module docs for the padding contract).
+#[derive(Clone, Debug)]
+pub struct ChunkGrid {
+    /// The chunk.
+    pub key: ChunkKey,
+    /// Tiles per axis (`n_t`).
+    pub tiles: usize,
+    /// Samples per padded axis, `tiles + 3`.
+    pub padded: usize,
+    /// Level-0 grid steps between samples.
+    pub stride: i64,
+    /// Face grid index of local voxel 0 along `u` and `v`.
+    pub i0: i64,
+    /// Face grid index of local voxel 0 along `v`.
+    pub j0: i64,
+    /// Depth index of local voxel 0.
+    pub k0: i64,
+    /// Unit direction of each padded column, index `b * padded + a`.
+    pub dirs: Vec<DVec3>,
+    /// Canonical lattice point of each padded column.
+    pub lattice: Vec<IVec3>,
+    /// Whether each padded column exists (false only past cube corners).
+    pub valid: Vec<bool>,
+    /// Radius of each padded layer, index `c`.
+    pub radii: Vec<f64>,
+    /// The chunk's origin in world space: mesh vertices are stored relative to it.
+    pub origin: DVec3,
+}
+
+impl ChunkGrid {
+    /// Builds the grid of `key`. Panics if the key is not a chunk of `layout` (a programming
+    /// error: keys from outside must be checked with [`Layout::contains_chunk`]).
+    pub fn new(layout: &Layout, key: ChunkKey) -> ChunkGrid {
+        assert!(layout.contains_chunk(&key), "chunk {key} is not part of the layout");
+        let tiles = layout.n_t() as usize;
+        let padded = tiles + 3;
+        let stride = key.stride();
+        let span = tiles as i64 * stride;
+        let (i0, j0, k0) = (i64::from(key.i) * span, i64::from(key.j) * span, i64::from(key.k) * span);
+        let mut dirs = Vec::with_capacity(padded * padded);
+        let mut lattice = Vec::with_capacity(padded * padded);
+        let mut valid = Vec::with_capacity(padded * padded);
+        let mut fallback = None;
+        for b in 0..padded {
+            for a in 0..padded {
+                let i = i0 + (a as i64 - 1) * stride;
+                let j = j0 + (b as i64 - 1) * stride;
+                match layout.lattice(key.face, i, j) {
+                    Some(l) => {
+                        lattice.push(l);
+                        dirs.push(layout.lattice_direction(l));
+                        valid.push(true);
+                        fallback.get_or_insert(l);
+                    }
+                    None => {
+                        // Past a cube corner: no voxel. Keep a harmless direction (the clamped
+                        // corner) so batch density calls stay finite; the mesher never reads it.
+                        let n = layout.face_tiles();
+                        let l = layout.lattice(key.face, i.clamp(0, n), j.clamp(0, n)).expect("clamped index is on the face");
+                        lattice.push(l);
+                        dirs.push(layout.lattice_direction(l));
+                        valid.push(false);
+                    }
+                }
+            }
+        }
+        let radii = (0..padded).map(|c| layout.layer_radius(k0 + (c as i64 - 1) * stride)).collect::<Vec<_>>();
+        let mid = padded / 2;
+        let origin = dirs[mid * padded + mid] * radii[mid];
+        ChunkGrid { key, tiles, padded, stride, i0, j0, k0, dirs, lattice, valid, radii, origin }
+    }
+
+    /// Number of padded samples, `padded^3`.
+    pub fn sample_count(&self) -> usize {
+        self.padded * self.padded * self.padded
+    }
+
+    /// Flat index of padded sample `(a, b, c)`: `a` fastest, then `b`, then `c` (depth).
+    #[inline]
+    pub fn index(&self, a: usize, b: usize, c: usize) -> usize {
+        (c * self.padded + b) * self.padded + a
+    }
+
+    /// World position of padded sample `(a, b, c)`.
+    #[inline]
+    pub fn position(&self, a: usize, b: usize, c: usize) -> DVec3 {
+        self.dirs[b * self.padded + a] * self.radii[c]
+    }
+
+    /// Canonical key of padded sample `(a, b, c)`.
+    #[inline]
+    pub fn voxel_key(&self, a: usize, b: usize, c: usize) -> VoxelKey {
+        VoxelKey::new(self.lattice[b * self.padded + a], (self.k0 + (c as i64 - 1) * self.stride) as i32)
+    }
+
+    /// The face of the chunk.
+    pub fn face(&self) -> Face {
+        self.key.face
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn neighbouring_chunks_share_border_voxels_bit_for_bit() {
+        let l = Layout::new(2, 4, 30.0, 1.0, 2).unwrap();
+        let mut seen: std::collections::HashMap<VoxelKey, DVec3> = Default::default();
+        for key in l.chunks(0) {
+            let g = ChunkGrid::new(&l, key);
+            for c in 1..=g.tiles + 1 {
+                for b in 1..=g.tiles + 1 {
+                    for a in 1..=g.tiles + 1 {
+                        let k = g.voxel_key(a, b, c);
+                        let p = g.position(a, b, c);
+                        let prev = *seen.entry(k).or_insert(p);
+                        assert_eq!(prev.to_array().map(f64::to_bits), p.to_array().map(f64::to_bits));
+                    }
+                }
+            }
+        }
+        assert_eq!(seen.len() as u64, l.unique_voxel_count());
+    }
+
+    #[test]
+    fn padding_is_invalid_only_past_cube_corners() {
+        let l = Layout::new(1, 4, 30.0, 1.0, 1).unwrap();
+        let g = ChunkGrid::new(&l, ChunkKey::new(Face::Top, 0, 0, 0));
+        let invalid = g.valid.iter().filter(|v| !**v).count();
+        assert_eq!(invalid, 4);
+    }
+
+    #[test]
+    #[should_panic(expected = "not part of the layout")]
+    fn foreign_key_is_refused() {
+        let l = Layout::new(1, 4, 30.0, 1.0, 1).unwrap();
+        ChunkGrid::new(&l, ChunkKey::new(Face::Top, 1, 0, 0));
+    }
+}

@@ -1,0 +1,341 @@
+//! The planet layout of seed 000 Sec. 4.3: parameters `n_c`, `n_t`, `d_b`, `l_d`, `d_c`, and the
+//! counts and radius of Eq. (2)-(4).
+
+use crate::cube_sphere::cube_to_sphere;
+use crate::face::Face;
+use crate::keys::{ChunkKey, VoxelKey};
+use glam::{DVec3, IVec3};
+
+/// Largest number of tiles along a face edge or the depth axis (keeps lattice keys in 32 bits).
+pub const MAX_AXIS_TILES: u64 = 1 << 24;
+/// Largest number of tiles per chunk axis (`n_t`): bounds the memory of one chunk.
+pub const MAX_CHUNK_TILES: u32 = 256;
+
+/// Why a set of layout parameters was refused. Each variant says which parameter to change.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LayoutError {
+    /// `n_c` must be at least 1: a face needs at least one chunk per side.
+    #[error("n_c (chunks per face side) must be at least 1, got {0}")]
+    ChunksPerSide(u32),
+    /// `n_t` must be in `1..=256`.
+    #[error("n_t (tiles per chunk side) must be between 1 and {MAX_CHUNK_TILES}, got {0}")]
+    TilesPerChunk(u32),
+    /// `d_c` must be at least 1.
+    #[error("d_c (chunks along the depth axis) must be at least 1, got {0}")]
+    DepthChunks(u32),
+    /// `l_d` must be a finite length above zero, in metres.
+    #[error("l_d (tile length along depth) must be a finite number of metres above 0, got {0}")]
+    TileDepth(f64),
+    /// `d_b` must be finite and at least `l_d`, so the padding layer below the base stays
+    /// outside the centre.
+    #[error("d_b (base depth, the radius of the innermost layer) must be a finite number of metres, at least l_d = {l_d}; got {d_b}")]
+    BaseDepth {
+        /// The refused base depth.
+        d_b: f64,
+        /// The tile depth it was compared with.
+        l_d: f64,
+    },
+    /// `n_c * n_t` or `n_t * d_c` is above 2^24 tiles.
+    #[error("the layout has {0} tiles along one axis, more than the supported {MAX_AXIS_TILES}; lower n_c, n_t or d_c")]
+    TooLarge(u64),
+}
+
+/// A validated planet layout (seed 000 Sec. 4.3).
+///
+/// A face holds `n_c x n_c` chunks at its base, `d_c` chunks deep; a chunk holds `n_t^3` tiles
+/// (morphed cubes, Fig. 9). Voxels are the tile corners: face grid indices `i, j` in `0..=N` with
+/// `N = n_c n_t`, depth index `k` in `0..=D` with `D = n_t d_c`. Layer `k` lies at radius
+/// `d_b + k l_d`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layout {
+    n_c: u32,
+    n_t: u32,
+    d_b: f64,
+    l_d: f64,
+    d_c: u32,
+}
+
+/// The default layout: `n_c = 8`, `n_t = 32`, `d_b = 1744 m`, `l_d = 4 m`, `d_c = 2`, radius 2000 m.
+impl Default for Layout {
+    fn default() -> Self {
+        Layout::new(8, 32, 1744.0, 4.0, 2).expect("default layout is valid")
+    }
+}
+
+impl Layout {
+    /// Validates and builds a layout from the paper's parameters.
+    pub fn new(n_c: u32, n_t: u32, d_b: f64, l_d: f64, d_c: u32) -> Result<Layout, LayoutError> {
+        if n_c == 0 {
+            return Err(LayoutError::ChunksPerSide(n_c));
+        }
+        if n_t == 0 || n_t > MAX_CHUNK_TILES {
+            return Err(LayoutError::TilesPerChunk(n_t));
+        }
+        if d_c == 0 {
+            return Err(LayoutError::DepthChunks(d_c));
+        }
+        if !(l_d.is_finite() && l_d > 0.0) {
+            return Err(LayoutError::TileDepth(l_d));
+        }
+        if !(d_b.is_finite() && d_b >= l_d) {
+            return Err(LayoutError::BaseDepth { d_b, l_d });
+        }
+        let face = u64::from(n_c) * u64::from(n_t);
+        let depth = u64::from(d_c) * u64::from(n_t);
+        if face > MAX_AXIS_TILES || depth > MAX_AXIS_TILES {
+            return Err(LayoutError::TooLarge(face.max(depth)));
+        }
+        Ok(Layout { n_c, n_t, d_b, l_d, d_c })
+    }
+
+    /// `n_c`: chunks along each side of a face.
+    pub fn n_c(&self) -> u32 {
+        self.n_c
+    }
+    /// `n_t`: tiles along each side of a chunk.
+    pub fn n_t(&self) -> u32 {
+        self.n_t
+    }
+    /// `d_b`: base depth, the radius of voxel layer 0, in metres.
+    pub fn d_b(&self) -> f64 {
+        self.d_b
+    }
+    /// `l_d`: length of a depth edge, in metres.
+    pub fn l_d(&self) -> f64 {
+        self.l_d
+    }
+    /// `d_c`: chunks along the depth axis.
+    pub fn d_c(&self) -> u32 {
+        self.d_c
+    }
+
+    /// `N = n_c n_t`: tiles along a face side.
+    pub fn face_tiles(&self) -> i64 {
+        i64::from(self.n_c) * i64::from(self.n_t)
+    }
+
+    /// `D = n_t d_c`: tiles along the depth axis.
+    pub fn depth_tiles(&self) -> i64 {
+        i64::from(self.n_t) * i64::from(self.d_c)
+    }
+
+    /// Eq. (2): the number of chunks, `6 n_c^2 d_c`.
+    pub fn chunk_count(&self) -> u64 {
+        6 * u64::from(self.n_c).pow(2) * u64::from(self.d_c)
+    }
+
+    /// Eq. (3): the number of voxels counted per face, `6 (n_t n_c + 1)^2 (n_t d_c + 1)`. Voxels
+    /// on face edges count once per face; see [`Layout::unique_voxel_count`].
+    pub fn voxel_count(&self) -> u64 {
+        let n = self.face_tiles() as u64;
+        let d = self.depth_tiles() as u64;
+        6 * (n + 1).pow(2) * (d + 1)
+    }
+
+    /// The number of distinct voxels once face-edge and corner voxels are paired:
+    /// `(6 N^2 + 2) (D + 1)`.
+    pub fn unique_voxel_count(&self) -> u64 {
+        let n = self.face_tiles() as u64;
+        let d = self.depth_tiles() as u64;
+        (6 * n * n + 2) * (d + 1)
+    }
+
+    /// Eq. (4): the planet radius `d_b + l_d n_t d_c` (the outermost voxel layer), in metres.
+    pub fn radius(&self) -> f64 {
+        self.layer_radius(self.depth_tiles())
+    }
+
+    /// The radius of voxel layer `k` (which may lie outside `0..=D` for padding).
+    #[inline]
+    pub fn layer_radius(&self, k: i64) -> f64 {
+        self.d_b + self.l_d * k as f64
+    }
+
+    /// The highest level of detail whose chunks tile the planet exactly: `2^L` must divide both
+    /// `n_c` and `d_c`.
+    pub fn max_level(&self) -> u8 {
+        self.n_c.trailing_zeros().min(self.d_c.trailing_zeros()) as u8
+    }
+
+    /// Chunks per face side at `level`.
+    pub fn chunks_per_side(&self, level: u8) -> u32 {
+        self.n_c >> level
+    }
+
+    /// Chunks along depth at `level`.
+    pub fn depth_chunks(&self, level: u8) -> u32 {
+        self.d_c >> level
+    }
+
+    /// Whether `key` names a chunk of this layout.
+    pub fn contains_chunk(&self, key: &ChunkKey) -> bool {
+        key.level <= self.max_level()
+            && key.i < self.chunks_per_side(key.level)
+            && key.j < self.chunks_per_side(key.level)
+            && key.k < self.depth_chunks(key.level)
+    }
+
+    /// All chunks of `level`, in key order (face, then i, j, k).
+    pub fn chunks(&self, level: u8) -> Vec<ChunkKey> {
+        let n = self.chunks_per_side(level);
+        let d = self.depth_chunks(level);
+        let mut out = Vec::with_capacity((6 * n * n * d) as usize);
+        for face in Face::ALL {
+            for i in 0..n {
+                for j in 0..n {
+                    for k in 0..d {
+                        out.push(ChunkKey { face, level, i, j, k });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The canonical lattice point of face grid indices `(i, j)`.
+    ///
+    /// Indices in `0..=N` lie on `face`. An index up to `N` past one side (the other in range)
+    /// lies on the neighbouring face, unfolded about the shared edge as in Algorithm 1: this is how
+    /// chunk padding reaches across face edges. Returns `None` when both indices are out of range
+    /// (there is no such point next to a cube corner) or when one is too far out.
+    pub fn lattice(&self, face: Face, i: i64, j: i64) -> Option<IVec3> {
+        let n = self.face_tiles();
+        let out_i = !(0..=n).contains(&i);
+        let out_j = !(0..=n).contains(&j);
+        if out_i && out_j {
+            return None;
+        }
+        let fr = face.frame();
+        // Components along u and v in half grid steps, and the excess past the face.
+        let fold = |x: i64| -> Option<(i64, i64)> {
+            if x < -n || x > 2 * n {
+                None
+            } else if x > n {
+                Some((n, x - n))
+            } else if x < 0 {
+                Some((-n, -x))
+            } else {
+                Some((2 * x - n, 0))
+            }
+        };
+        let (cu, eu) = fold(i)?;
+        let (cv, ev) = fold(j)?;
+        let cn = n - 2 * (eu + ev);
+        let p = fr.n.as_i64vec3() * cn + fr.u.as_i64vec3() * cu + fr.v.as_i64vec3() * cv;
+        Some(p.as_ivec3())
+    }
+
+    /// The canonical key of voxel `(i, j, k)` of `face` (see [`Layout::lattice`] for the range).
+    pub fn voxel_key(&self, face: Face, i: i64, j: i64, k: i64) -> Option<VoxelKey> {
+        Some(VoxelKey::new(self.lattice(face, i, j)?, k as i32))
+    }
+
+    /// The unit direction of a lattice point.
+    #[inline]
+    pub fn lattice_direction(&self, lattice: IVec3) -> DVec3 {
+        let n = self.face_tiles() as f64;
+        cube_to_sphere(lattice.as_dvec3() / n)
+    }
+
+    /// The world position (metres, planet-centred) of a voxel, from its canonical key only.
+    pub fn voxel_position(&self, key: VoxelKey) -> DVec3 {
+        self.lattice_direction(IVec3::from_array(key.lattice)) * self.layer_radius(i64::from(key.k))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::face_conversion::FaceTransition;
+    use proptest::prelude::*;
+
+    #[test]
+    fn formulas_match_the_paper() {
+        let l = Layout::new(4, 16, 100.0, 2.0, 3).unwrap();
+        assert_eq!(l.chunk_count(), 6 * 16 * 3);
+        assert_eq!(l.voxel_count(), 6 * 65 * 65 * 49);
+        assert_eq!(l.radius(), 100.0 + 2.0 * 48.0);
+        assert_eq!(l.chunks(0).len() as u64, l.chunk_count());
+        let d = Layout::default();
+        assert_eq!(d.radius(), 2000.0);
+    }
+
+    #[test]
+    fn unique_voxels_are_counted_by_distinct_lattice_points() {
+        let l = Layout::new(2, 3, 10.0, 1.0, 1).unwrap();
+        let n = l.face_tiles();
+        let mut set = std::collections::HashSet::new();
+        for f in Face::ALL {
+            for i in 0..=n {
+                for j in 0..=n {
+                    set.insert(l.lattice(f, i, j).unwrap());
+                }
+            }
+        }
+        assert_eq!(set.len() as u64 * (l.depth_tiles() as u64 + 1), l.unique_voxel_count());
+    }
+
+    #[test]
+    fn rejects_invalid_parameters() {
+        assert_eq!(Layout::new(0, 8, 10.0, 1.0, 1), Err(LayoutError::ChunksPerSide(0)));
+        assert_eq!(Layout::new(1, 0, 10.0, 1.0, 1), Err(LayoutError::TilesPerChunk(0)));
+        assert_eq!(Layout::new(1, 8, 10.0, 1.0, 0), Err(LayoutError::DepthChunks(0)));
+        assert!(matches!(Layout::new(1, 8, 10.0, f64::NAN, 1), Err(LayoutError::TileDepth(_))));
+        assert!(matches!(Layout::new(1, 8, 10.0, -1.0, 1), Err(LayoutError::TileDepth(_))));
+        assert!(matches!(Layout::new(1, 8, f64::NAN, 1.0, 1), Err(LayoutError::BaseDepth { .. })));
+        assert!(matches!(Layout::new(1, 8, -5.0, 1.0, 1), Err(LayoutError::BaseDepth { .. })));
+        assert!(matches!(Layout::new(1 << 20, 256, 10.0, 1.0, 1), Err(LayoutError::TooLarge(_))));
+    }
+
+    /// Face-edge and corner voxels get one key whichever face names them.
+    #[test]
+    fn paired_voxels_share_one_key() {
+        let l = Layout::new(3, 4, 50.0, 1.0, 1).unwrap();
+        let n = l.face_tiles();
+        let mut owners: std::collections::HashMap<IVec3, Vec<Face>> = Default::default();
+        for f in Face::ALL {
+            for i in 0..=n {
+                for j in 0..=n {
+                    owners.entry(l.lattice(f, i, j).unwrap()).or_default().push(f);
+                }
+            }
+        }
+        let corners = owners.values().filter(|v| v.len() == 3).count();
+        let edges = owners.values().filter(|v| v.len() == 2).count();
+        assert_eq!(corners, 8);
+        assert_eq!(edges as i64, 12 * (n - 1));
+        assert!(owners.values().all(|v| v.len() <= 3));
+    }
+
+    /// Padding past a face edge is the neighbour's voxel found by Algorithm 1.
+    #[test]
+    fn padding_fold_agrees_with_algorithm_1() {
+        let l = Layout::new(2, 4, 50.0, 1.0, 1).unwrap();
+        let n = l.face_tiles();
+        for a in Face::ALL {
+            for b in Face::ALL {
+                let Some(tr) = FaceTransition::new(a, b) else { continue };
+                for e in 1..=3 {
+                    for t in 0..=n {
+                        for (i, j) in [(n + e, t), (-e, t), (t, n + e), (t, -e)] {
+                            let (i2, j2) = tr.convert_index(i, j, n);
+                            if (0..=n).contains(&i2) && (0..=n).contains(&j2) {
+                                assert_eq!(l.lattice(a, i, j), l.lattice(b, i2, j2), "{a}->{b} ({i},{j})");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn voxel_positions_lie_on_their_layer(fi in 0usize..6, i in 0i64..=24, j in 0i64..=24, k in 0i64..=8) {
+            let l = Layout::new(3, 8, 100.0, 2.5, 1).unwrap();
+            let key = l.voxel_key(Face::ALL[fi], i, j, k).unwrap();
+            let p = l.voxel_position(key);
+            prop_assert!((p.length() - l.layer_radius(k)).abs() < 1e-9);
+        }
+    }
+}

@@ -1,0 +1,140 @@
+//! The union of all chunk meshes of a planet is a closed, consistently oriented 2-manifold:
+//! every edge is shared by exactly two triangles, across chunk borders, face edges and cube
+//! corners, with vertices identified by their canonical grid edge (no welding tolerance).
+
+use pmc_density::{Density, FnDensity, Sphere};
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::{ChunkGrid, EdgeKey, Layout};
+use pmc_mesh::{close_shell, ChunkMesh, Mesher};
+use proptest::prelude::*;
+use std::collections::HashMap;
+
+fn mesh_planet(layout: &Layout, density: &dyn Density) -> Vec<ChunkMesh> {
+    let mut mesher = Mesher::new();
+    let mut out = Vec::new();
+    for key in layout.chunks(0) {
+        let grid = ChunkGrid::new(layout, key);
+        let radii = &grid.radii;
+        let mut d = vec![0.0f32; grid.sample_count()];
+        density.sample_shell(&grid.dirs, radii, &mut d);
+        close_shell(&grid, layout.depth_tiles(), &mut d);
+        let mut m = ChunkMesh::default();
+        mesher.mesh(&grid, &d, &mut m);
+        out.push(m);
+    }
+    out
+}
+
+struct Welded {
+    vertices: Vec<DVec3>,
+    triangles: Vec<[usize; 3]>,
+}
+
+fn weld(meshes: &[ChunkMesh]) -> Welded {
+    let mut ids: HashMap<EdgeKey, usize> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for m in meshes {
+        let local: Vec<usize> = (0..m.vertex_count())
+            .map(|i| {
+                *ids.entry(m.edge_keys[i]).or_insert_with(|| {
+                    vertices.push(m.world_position(i));
+                    vertices.len() - 1
+                })
+            })
+            .collect();
+        for t in m.indices.chunks_exact(3) {
+            triangles.push([local[t[0] as usize], local[t[1] as usize], local[t[2] as usize]]);
+        }
+    }
+    Welded { vertices, triangles }
+}
+
+/// Checks the closed-manifold property; returns the Euler characteristic.
+fn check_closed(w: &Welded) -> i64 {
+    let mut directed: HashMap<(usize, usize), u32> = HashMap::new();
+    for t in &w.triangles {
+        assert!(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "collapsed triangle {t:?}");
+        for k in 0..3 {
+            *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    for (&(a, b), &n) in &directed {
+        assert_eq!(n, 1, "directed edge {a}->{b} used {n} times (non-manifold or flipped)");
+        assert_eq!(directed.get(&(b, a)), Some(&1), "boundary edge {a}-{b}: the surface is open");
+    }
+    let e = directed.len() as i64 / 2;
+    w.vertices.len() as i64 - e + w.triangles.len() as i64
+}
+
+fn volume(w: &Welded) -> f64 {
+    w.triangles.iter().map(|t| w.vertices[t[0]].dot(w.vertices[t[1]].cross(w.vertices[t[2]])) / 6.0).sum()
+}
+
+#[test]
+fn sphere_is_closed_with_euler_2_and_the_right_volume() {
+    let layout = Layout::new(4, 16, 60.0, 1.0, 2).unwrap();
+    let r = 60.0 + 16.37;
+    let meshes = mesh_planet(&layout, &Sphere { radius: r });
+    let w = weld(&meshes);
+    assert_eq!(check_closed(&w), 2);
+    let exact = 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+    let v = volume(&w);
+    assert!((v - exact).abs() / exact < 0.005, "volume {v} vs {exact}");
+    // Every vertex lies on the sphere: radial edges cut it exactly.
+    for p in &w.vertices {
+        assert!((p.length() - r).abs() < 1e-3, "vertex off the sphere by {}", p.length() - r);
+    }
+}
+
+#[test]
+fn normals_agree_across_chunk_and_face_borders() {
+    let layout = Layout::new(2, 8, 40.0, 1.0, 2).unwrap();
+    let f = FnDensity(|p: DVec3| 48.3 - p.length() + 2.0 * (p.x * 0.21).sin() * (p.z * 0.17).cos());
+    let meshes = mesh_planet(&layout, &f);
+    let mut seen: HashMap<EdgeKey, ([u32; 3], [f32; 3])> = HashMap::new();
+    let mut shared = 0;
+    for m in &meshes {
+        for i in 0..m.vertex_count() {
+            let wp = m.world_position(i);
+            let n = m.normals[i];
+            let bits = [wp.x as f32, wp.y as f32, wp.z as f32].map(f32::to_bits);
+            if let Some((pb, pn)) = seen.insert(m.edge_keys[i], (bits, n)) {
+                shared += 1;
+                let dp: Vec<f32> = (0..3).map(|k| (f32::from_bits(pb[k]) - f32::from_bits(bits[k])).abs()).collect();
+                assert!(dp.iter().all(|d| *d < 1e-3), "shared vertex moved: {dp:?}");
+                let dot = pn[0] * n[0] + pn[1] * n[1] + pn[2] * n[2];
+                assert!(dot > 0.99, "shared vertex normals disagree: {pn:?} vs {n:?}");
+            }
+        }
+    }
+    assert!(shared > 100, "the test surface crosses chunk borders");
+}
+
+/// A hash-based value field: rough, with many ambiguous cube configurations.
+fn rough_field(seed: u64, scale: f64, base: f64) -> impl Fn(DVec3) -> f64 + Send + Sync {
+    move |p: DVec3| {
+        let q = (p * scale).floor();
+        let mut h = seed ^ 0x9E37_79B9_7F4A_7C15;
+        for c in [q.x, q.y, q.z] {
+            h ^= (c as i64 as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h = (h ^ (h >> 31)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        }
+        let noise = (h >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        base - p.length() + noise * 8.0
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    #[test]
+    fn random_fields_mesh_to_closed_manifolds(seed in any::<u64>(), n_c in 1u32..3, n_t in 2u32..7, d_c in 1u32..3, scale in 0.3f64..1.5) {
+        let layout = Layout::new(n_c, n_t, 20.0, 1.0, d_c).unwrap();
+        let mid = 20.0 + f64::from(n_t * d_c) * 0.5;
+        let f = FnDensity(rough_field(seed, scale, mid));
+        let meshes = mesh_planet(&layout, &f);
+        let w = weld(&meshes);
+        prop_assert!(!w.triangles.is_empty());
+        check_closed(&w);
+    }
+}

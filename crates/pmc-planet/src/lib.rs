@@ -1,0 +1,22 @@
+//! A planet: layout plus terrain, meshed chunk by chunk.
+//!
+//! [`Planet::chunk_mesh`] runs the whole pipeline for one chunk (sample the density in one batch
+//! call, apply the shell boundary contract, march the cubes, shade the vertices);
+//! [`Planet::generate`] does it for every chunk on all threads. Output is deterministic: the same
+//! preset, seed and layout give byte-identical meshes at any thread count, because every chunk is
+//! computed from canonical voxel keys alone and results are ordered by chunk key.
+//!
+//! ```
+//! use pmc_planet::{Planet, PresetKind};
+//! use pmc_geometry::Layout;
+//! let planet = Planet::new(PresetKind::Sphere, 1, Layout::new(1, 8, 40.0, 1.0, 1).unwrap());
+//! let meshes = planet.generate(|_| {});
+//! assert!(meshes.iter().map(|m| m.triangle_count()).sum::<usize>() > 0);
+//! ```
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+mod planet;
+
+pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};
+pub use planet::{ChunkScratch, Planet};
