@@ -23,6 +23,13 @@ pub struct Mesher {
     /// Per padded voxel: generation of the cached gradient.
     grad_stamp: Vec<u32>,
     grad: Vec<DVec3>,
+    /// Solidity bits per voxel row (fast path).
+    rows: Vec<u128>,
+    /// Per padded column: generation of the cached reciprocal frame.
+    col_stamp: Vec<u32>,
+    col_basis: Vec<[DVec3; 3]>,
+    /// Per padded layer: `1 / r` and `1 / (r[c + 1] - r[c - 1])`.
+    inv_radii: Vec<[f64; 2]>,
 }
 
 impl Mesher {
@@ -45,50 +52,127 @@ impl Mesher {
         out.key = Some(grid.key);
         out.origin = grid.origin;
         let p = grid.padded;
-        let n = grid.tiles;
         let total = p * p * p;
         if self.edge_cache.len() < total * 3 {
             self.edge_cache = vec![0; total * 3];
             self.grad_stamp = vec![0; total];
             self.grad = vec![DVec3::ZERO; total];
+            self.col_stamp = vec![0; p * p];
+            self.col_basis = vec![[DVec3::ZERO; 3]; p * p];
             self.generation = 0;
         }
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             self.edge_cache.fill(0);
             self.grad_stamp.fill(0);
+            self.col_stamp.fill(0);
             self.generation = 1;
         }
 
-        if !has_sign_change(grid, densities) {
-            return;
-        }
-
+        self.inv_radii.clear();
+        self.inv_radii.extend((0..p).map(|c| {
+            let dr = grid.radii[(c + 1).min(p - 1)] - grid.radii[c.saturating_sub(1)];
+            [1.0 / grid.radii[c], 1.0 / dr]
+        }));
         let tables = &*TABLES;
-        let corner_index: [usize; 8] = std::array::from_fn(|c| {
-            let o = corner_offset(c as u8);
-            (o[2] * p + o[1]) * p + o[0]
-        });
         let mut ctx = Ctx { grid, densities, mesher: self, out };
-        for c in 1..=n {
-            for b in 1..=n {
-                let row = grid.index(0, b, c);
-                for a in 1..=n {
-                    let base = row + a;
-                    let mut case = 0u8;
-                    for (k, off) in corner_index.iter().enumerate() {
-                        if is_solid(densities[base + off]) {
-                            case |= 1 << k;
-                        }
-                    }
-                    if case == 0 || case == 255 {
-                        continue;
-                    }
-                    for tri in tables.case(case) {
-                        let v = tri.map(|e| ctx.vertex(a, b, c, e));
-                        ctx.out.indices.extend_from_slice(&v);
+        if p <= 128 {
+            march_bit_rows(&mut ctx, tables);
+        } else {
+            march_plain(&mut ctx, tables);
+        }
+    }
+}
+
+/// The fast path for chunks up to 125 tiles wide: solidity packed into one `u128` per voxel row,
+/// so whole runs of empty or full cubes are skipped with a few bit operations.
+fn march_bit_rows(ctx: &mut Ctx<'_>, tables: &crate::tables::McTables) {
+    let grid = ctx.grid;
+    let (p, n) = (grid.padded, grid.tiles);
+    let mut rows = std::mem::take(&mut ctx.mesher.rows);
+    rows.clear();
+    rows.extend(ctx.densities.chunks_exact(p).map(|row| {
+        let (lo, hi) = row.split_at(p.min(64));
+        let pack = |part: &[f32]| {
+            let mut w = 0u64;
+            let mut lanes = part.chunks_exact(8);
+            for (k, lane) in lanes.by_ref().enumerate() {
+                let mut m = 0u64;
+                for (i, d) in lane.iter().enumerate() {
+                    m |= u64::from(is_solid(*d)) << i;
+                }
+                w |= m << (8 * k);
+            }
+            let base = part.len() - lanes.remainder().len();
+            for (i, d) in lanes.remainder().iter().enumerate() {
+                w |= u64::from(is_solid(*d)) << (base + i);
+            }
+            w
+        };
+        u128::from(pack(lo)) | (u128::from(pack(hi)) << 64)
+    }));
+    // Bits 1..=n+1 are the chunk's own voxels; cubes start at bits 1..=n.
+    let voxel_mask: u128 = ((1u128 << (n + 1)) - 1) << 1;
+    let cube_mask: u128 = ((1u128 << n) - 1) << 1;
+    let (mut any, mut all) = (0u128, voxel_mask);
+    for c in 1..=n + 1 {
+        for b in 1..=n + 1 {
+            let r = rows[c * p + b] & voxel_mask;
+            any |= r;
+            all &= r;
+        }
+    }
+    if any == 0 || all == voxel_mask {
+        ctx.mesher.rows = rows;
+        return;
+    }
+    for c in 1..=n {
+        for b in 1..=n {
+            let r00 = rows[c * p + b];
+            let r10 = rows[c * p + b + 1];
+            let r01 = rows[(c + 1) * p + b];
+            let r11 = rows[(c + 1) * p + b + 1];
+            let or = r00 | r10 | r01 | r11;
+            let and = r00 & r10 & r01 & r11;
+            let mut live = (or | (or >> 1)) & !(and & (and >> 1)) & cube_mask;
+            while live != 0 {
+                let a = live.trailing_zeros() as usize;
+                live &= live - 1;
+                let bits = |r: u128| ((r >> a) & 3) as u8;
+                let case = bits(r00) | (bits(r10) << 2) | (bits(r01) << 4) | (bits(r11) << 6);
+                ctx.emit_cube(tables, case, a, b, c);
+            }
+        }
+    }
+    ctx.mesher.rows = rows;
+}
+
+/// The general path: every cube's case from its eight samples.
+fn march_plain(ctx: &mut Ctx<'_>, tables: &crate::tables::McTables) {
+    let grid = ctx.grid;
+    let (p, n) = (grid.padded, grid.tiles);
+    if !has_sign_change(grid, ctx.densities) {
+        return;
+    }
+    let corner_index: [usize; 8] = std::array::from_fn(|c| {
+        let o = corner_offset(c as u8);
+        (o[2] * p + o[1]) * p + o[0]
+    });
+    for c in 1..=n {
+        for b in 1..=n {
+            let row = grid.index(0, b, c);
+            for a in 1..=n {
+                let base = row + a;
+                let mut case = 0u8;
+                for (k, off) in corner_index.iter().enumerate() {
+                    if is_solid(ctx.densities[base + off]) {
+                        case |= 1 << k;
                     }
                 }
+                if case == 0 || case == 255 {
+                    continue;
+                }
+                ctx.emit_cube(tables, case, a, b, c);
             }
         }
     }
@@ -117,6 +201,21 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// Emits the triangles of one cube: each cut edge's vertex is looked up once.
+    #[inline]
+    fn emit_cube(&mut self, tables: &crate::tables::McTables, case: u8, a: usize, b: usize, c: usize) {
+        let mut verts = [0u32; 12];
+        let mut mask = tables.edge_masks[case as usize];
+        while mask != 0 {
+            let e = mask.trailing_zeros() as u8;
+            mask &= mask - 1;
+            verts[e as usize] = self.vertex(a, b, c, e);
+        }
+        for tri in tables.case(case) {
+            self.out.indices.extend_from_slice(&tri.map(|e| verts[e as usize]));
+        }
+    }
+
     /// The vertex on cube edge `e` of the cube whose lowest corner is padded voxel `(a, b, c)`.
     #[inline]
     fn vertex(&mut self, a: usize, b: usize, c: usize, e: u8) -> u32 {
@@ -159,37 +258,57 @@ impl Ctx<'_> {
         let gf = self.gradient(f);
         let gs = self.gradient(s);
         let grad = gf + (gs - gf) * t;
-        let normal = (-grad).try_normalize().unwrap_or_else(|| pos.normalize_or(DVec3::Y));
+        // Normalise in f32: the gradient's direction is all that is kept.
+        let normal = (-grad)
+            .as_vec3()
+            .try_normalize()
+            .unwrap_or_else(|| pos.normalize_or(DVec3::Y).as_vec3());
         let rel = pos - g.origin;
         let out = &mut *self.out;
         let idx = out.positions.len() as u32;
         out.positions.push(rel.as_vec3().to_array());
-        out.normals.push(normal.as_vec3().normalize_or(pmc_geometry::glam::Vec3::Y).to_array());
+        out.normals.push(normal.to_array());
         out.edge_keys.push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
         idx
     }
 
     /// The density gradient at a padded voxel by central differences over its six axis
     /// neighbours, solved in world space through the grid's (non-orthogonal) local frame.
+    ///
+    /// Voxel positions factor as `dir(a, b) * radius(c)`, so the frame's reciprocal basis depends
+    /// on the column only and is cached per column.
     fn gradient(&mut self, v: (usize, usize, usize)) -> DVec3 {
         let g = self.grid;
         let vi = g.index(v.0, v.1, v.2);
-        if self.mesher.grad_stamp[vi] == self.mesher.generation {
+        let gen = self.mesher.generation;
+        if self.mesher.grad_stamp[vi] == gen {
             return self.mesher.grad[vi];
         }
         let (a, b, c) = v;
-        let d = |x: usize, y: usize, z: usize| f64::from(self.densities[g.index(x, y, z)]);
-        let pos = |x: usize, y: usize, z: usize| g.position(x, y, z);
-        let eu = pos(a + 1, b, c) - pos(a - 1, b, c);
-        let ev = pos(a, b + 1, c) - pos(a, b - 1, c);
-        let ek = pos(a, b, c + 1) - pos(a, b, c - 1);
-        let du = d(a + 1, b, c) - d(a - 1, b, c);
-        let dv = d(a, b + 1, c) - d(a, b - 1, c);
-        let dk = d(a, b, c + 1) - d(a, b, c - 1);
-        let cvk = ev.cross(ek);
-        let det = eu.dot(cvk);
-        let grad = if det.abs() > 0.0 { (cvk * du + ek.cross(eu) * dv + eu.cross(ev) * dk) / det } else { DVec3::ZERO };
-        self.mesher.grad_stamp[vi] = self.mesher.generation;
+        let p = g.padded;
+        let col = b * p + a;
+        if self.mesher.col_stamp[col] != gen {
+            let n = g.dirs[col];
+            let eu = g.dirs[col + 1] - g.dirs[col - 1];
+            let ev = g.dirs[col + p] - g.dirs[col - p];
+            let cvn = ev.cross(n);
+            let det = eu.dot(cvn);
+            self.mesher.col_basis[col] = if det.abs() > 0.0 {
+                [cvn / det, n.cross(eu) / det, eu.cross(ev) / det]
+            } else {
+                [DVec3::ZERO; 3]
+            };
+            self.mesher.col_stamp[col] = gen;
+        }
+        let [ru, rv, rk] = self.mesher.col_basis[col];
+        let d = |i: usize| f64::from(self.densities[i]);
+        let layer = p * p;
+        let du = d(vi + 1) - d(vi - 1);
+        let dv = d(vi + p) - d(vi - p);
+        let dk = d(vi + layer) - d(vi - layer);
+        let [inv_r, inv_dr] = self.mesher.inv_radii[c];
+        let grad = (ru * du + rv * dv) * inv_r + rk * (dk * inv_dr);
+        self.mesher.grad_stamp[vi] = gen;
         self.mesher.grad[vi] = grad;
         grad
     }

@@ -1,0 +1,21 @@
+//! A whole chunk: density batch, shell contract, marching cubes and shading.
+use criterion::{criterion_group, criterion_main, Criterion};
+use pmc_bench::{default_planet, surface_chunk};
+use pmc_mesh::ChunkMesh;
+use pmc_planet::ChunkScratch;
+
+fn chunk(c: &mut Criterion) {
+    let planet = default_planet();
+    let key = surface_chunk(&planet);
+    let mut scratch = ChunkScratch::default();
+    let mut out = ChunkMesh::default();
+    planet.chunk_mesh_into(key, &mut scratch, &mut out);
+    let mut g = c.benchmark_group("chunk");
+    g.bench_function(format!("earthlike/full/tris={}", out.triangle_count()), |b| {
+        b.iter(|| planet.chunk_mesh_into(key, &mut scratch, &mut out))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, chunk);
+criterion_main!(benches);

@@ -1,0 +1,41 @@
+//! Errors the command reports to the user.
+
+use std::path::PathBuf;
+
+/// A failure of a `pmc` command. Printed as `error: <message>`; the process exits with code 2
+/// for invalid input and 1 for failures while working.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Invalid layout parameters.
+    #[error("invalid planet layout: {0}")]
+    Layout(#[from] pmc_geometry::LayoutError),
+    /// The output path cannot be written.
+    #[error("cannot write {path}: {reason}")]
+    Output {
+        /// The output path.
+        path: PathBuf,
+        /// What is wrong and how to fix it.
+        reason: String,
+    },
+    /// Export failed.
+    #[error(transparent)]
+    Export(#[from] pmc_formats::ExportError),
+    /// The thread pool could not start.
+    #[error("cannot start {threads} worker threads: {reason}")]
+    Threads {
+        /// Requested thread count.
+        threads: usize,
+        /// The system's reason.
+        reason: String,
+    },
+}
+
+impl CliError {
+    /// The process exit code for this error.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Layout(_) | CliError::Output { .. } => 2,
+            CliError::Export(_) | CliError::Threads { .. } => 1,
+        }
+    }
+}

@@ -1,0 +1,41 @@
+//! `pmc`: planetary marching cubes from the command line.
+#![forbid(unsafe_code)]
+
+mod error;
+mod generate;
+mod info;
+mod planet_args;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Planetary marching cubes: closed planets with caves and overhangs, meshed on a cube-sphere.
+#[derive(Parser, Debug)]
+#[command(name = "pmc", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Mesh a whole planet and write it to a file (.glb, .obj or .ply).
+    Generate(generate::GenerateArgs),
+    /// Print the layout (chunk and voxel counts, radius: seed 000 Eq. 2-4) and the terrain.
+    Info(info::InfoArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Generate(a) => generate::run(a),
+        Command::Info(a) => info::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

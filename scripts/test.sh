@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Runs every test of the project: formatting, lints, the Rust test suite, and the external checks
+# of exported planets (Khronos glTF validator, trimesh). Installs what it needs on a fresh machine.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+step() { printf '\n==> %s\n' "$*"; }
+
+step "cargo fmt --check"
+cargo fmt --all -- --check
+
+step "cargo clippy (warnings denied)"
+cargo clippy --workspace --all-targets --locked -- -D warnings
+
+step "cargo test"
+cargo test --workspace --locked
+
+step "build pmc (release)"
+cargo build --release --locked --bin pmc
+PMC=target/release/pmc
+
+step "install external validators"
+if [ ! -d tools/gltf-validate/node_modules/gltf-validator ]; then
+  (cd tools/gltf-validate && npm ci --no-audit --no-fund --loglevel=error)
+fi
+if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
+  python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
+fi
+
+OUT=target/test-artifacts
+mkdir -p "$OUT"
+
+step "export planets and validate them"
+"$PMC" generate --quiet --preset sphere --n-c 4 --n-t 16 -o "$OUT/sphere.glb"
+"$PMC" generate --quiet --preset sphere --n-c 4 --n-t 16 -o "$OUT/sphere.ply"
+"$PMC" generate --quiet --preset earthlike --seed 7 -o "$OUT/earthlike.glb"
+"$PMC" generate --quiet --preset earthlike --seed 7 --n-c 4 -o "$OUT/earthlike.ply"
+"$PMC" generate --quiet --preset moon --seed 3 --n-c 4 -o "$OUT/moon.glb"
+"$PMC" generate --quiet --preset mars --seed 5 --n-c 4 -o "$OUT/mars.glb"
+node tools/gltf-validate/validate.mjs "$OUT/sphere.glb" "$OUT/earthlike.glb" "$OUT/moon.glb" "$OUT/mars.glb"
+
+# The sphere preset's radius: d_b + T/2 + 0.37 l_d with T = l_d n_t d_c.
+R=$(python3 -c "print(1744 + 4*16*2/2 + 0.37*4)")
+V=$(python3 -c "import math; print(4/3*math.pi*$R**3)")
+python3 tools/check_mesh.py "$OUT/sphere.ply" --expect-euler 2 --expect-volume "$V" --tolerance 0.005
+python3 tools/check_mesh.py "$OUT/earthlike.ply"
+
+step "all checks passed"
