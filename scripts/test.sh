@@ -6,6 +6,14 @@ cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s\n' "$*"; }
 
+step "install external validators"
+if [ ! -d tools/gltf-validate/node_modules/gltf-validator ]; then
+  (cd tools/gltf-validate && npm ci --no-audit --no-fund --loglevel=error)
+fi
+if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
+  python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
+fi
+
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
@@ -18,14 +26,6 @@ cargo test --workspace --locked
 step "build pmc (release)"
 cargo build --release --locked --bin pmc
 PMC=target/release/pmc
-
-step "install external validators"
-if [ ! -d tools/gltf-validate/node_modules/gltf-validator ]; then
-  (cd tools/gltf-validate && npm ci --no-audit --no-fund --loglevel=error)
-fi
-if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
-  python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
-fi
 
 OUT=target/test-artifacts
 mkdir -p "$OUT"

@@ -12,7 +12,12 @@ fn density(c: &mut Criterion) {
         let grid = ChunkGrid::new(planet.layout(), key);
         let mut out = vec![0.0f32; grid.sample_count()];
         g.bench_function(format!("earthlike/{name}/samples={}", grid.sample_count()), |b| {
-            b.iter(|| planet.terrain().density.sample_shell(black_box(&grid.dirs), &grid.radii, &mut out))
+            b.iter(|| {
+                planet
+                    .terrain()
+                    .density
+                    .sample_shell(black_box(&grid.dirs), &grid.radii, &mut out)
+            })
         });
     }
     g.finish();

@@ -14,7 +14,9 @@ fn marching_cubes(c: &mut Criterion) {
     let mut g = c.benchmark_group("marching_cubes");
     let mut mesher = Mesher::new();
     let mut out = ChunkMesh::default();
-    g.bench_function(format!("pmc/tris={tris}"), |b| b.iter(|| mesher.mesh(&grid, black_box(&d), &mut out)));
+    g.bench_function(format!("pmc/tris={tris}"), |b| {
+        b.iter(|| mesher.mesh(&grid, black_box(&d), &mut out))
+    });
 
     // fast-surface-nets treats negative as inside: negate, outside the timed loop.
     let p = grid.padded as u32;

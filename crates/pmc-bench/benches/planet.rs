@@ -7,7 +7,9 @@ fn planet(c: &mut Criterion) {
     let tris: usize = planet.generate(|_| {}).iter().map(|m| m.triangle_count()).sum();
     let mut g = c.benchmark_group("planet");
     g.sample_size(10);
-    g.bench_function(format!("earthlike/default/tris={tris}"), |b| b.iter(|| planet.generate(|_| {})));
+    g.bench_function(format!("earthlike/default/tris={tris}"), |b| {
+        b.iter(|| planet.generate(|_| {}))
+    });
     g.finish();
 }
 

@@ -20,6 +20,9 @@ pub enum CliError {
     /// Export failed.
     #[error(transparent)]
     Export(#[from] pmc_formats::ExportError),
+    /// Rendering failed (bad camera or options, or the PNG could not be written).
+    #[error(transparent)]
+    Render(#[from] pmc_render::RenderError),
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads: {reason}")]
     Threads {
@@ -35,6 +38,8 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Layout(_) | CliError::Output { .. } => 2,
+            CliError::Render(pmc_render::RenderError::Io { .. } | pmc_render::RenderError::Png { .. }) => 1,
+            CliError::Render(_) => 2,
             CliError::Export(_) | CliError::Threads { .. } => 1,
         }
     }

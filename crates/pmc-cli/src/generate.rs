@@ -30,14 +30,20 @@ pub struct GenerateArgs {
 
 /// Checks, before any work, that `path` can be written in a known format.
 fn check_output(path: &Path) -> Result<(), CliError> {
-    let err = |reason: String| CliError::Output { path: path.to_path_buf(), reason };
+    let err = |reason: String| CliError::Output {
+        path: path.to_path_buf(),
+        reason,
+    };
     Format::from_path(path).map_err(|e| err(e.to_string()))?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
     if !dir.is_dir() {
-        return Err(err(format!("the directory {} does not exist; create it first", dir.display())));
+        return Err(err(format!(
+            "the directory {} does not exist; create it first",
+            dir.display()
+        )));
     }
     if path.is_dir() {
         return Err(err("it is a directory; give a file name such as planet.glb".into()));
@@ -59,11 +65,18 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
-        .map_err(|e| CliError::Threads { threads: args.threads, reason: e.to_string() })?;
+        .map_err(|e| CliError::Threads {
+            threads: args.threads,
+            reason: e.to_string(),
+        })?;
     let start = Instant::now();
     let planet = pmc_planet::Planet::new(args.planet.preset, args.planet.seed, layout);
     let total = layout.chunk_count();
-    let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr()) };
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    };
     bar.set_style(
         ProgressStyle::with_template("{spinner} meshing chunks {bar:40} {pos}/{len} ({elapsed}, eta {eta})")
             .expect("valid template"),
@@ -85,7 +98,11 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
         materials: t.materials.iter().map(|s| s.to_string()).collect(),
         generator: format!("pmc {}", env!("CARGO_PKG_VERSION")),
     };
-    let spinner = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
+    let spinner = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new_spinner()
+    };
     spinner.set_message(format!("writing {}", args.output.display()));
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let stats = pmc_formats::export(&args.output, &meshes, &meta)?;

@@ -44,18 +44,43 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         println!("{}", serde_json::to_string_pretty(&v).expect("JSON of plain values"));
         return Ok(());
     }
-    println!("planet       preset {} ({}), seed {}", t.kind, t.kind.description(), t.seed);
-    println!("layout       n_c = {}, n_t = {}, d_b = {} m, l_d = {} m, d_c = {}", l.n_c(), l.n_t(), l.d_b(), l.l_d(), l.d_c());
+    println!(
+        "planet       preset {} ({}), seed {}",
+        t.kind,
+        t.kind.description(),
+        t.seed
+    );
+    println!(
+        "layout       n_c = {}, n_t = {}, d_b = {} m, l_d = {} m, d_c = {}",
+        l.n_c(),
+        l.n_t(),
+        l.d_b(),
+        l.l_d(),
+        l.d_c()
+    );
     println!("chunks       {} (Eq. 2: 6 n_c^2 d_c)", l.chunk_count());
-    println!("voxels       {} (Eq. 3: 6 (n_t n_c + 1)^2 (n_t d_c + 1)), {} once paired", l.voxel_count(), l.unique_voxel_count());
+    println!(
+        "voxels       {} (Eq. 3: 6 (n_t n_c + 1)^2 (n_t d_c + 1)), {} once paired",
+        l.voxel_count(),
+        l.unique_voxel_count()
+    );
     println!("radius       {} m (Eq. 4: d_b + l_d n_t d_c)", l.radius());
-    println!("grid         {} tiles per face side, {} deep; tiles about {:.2} m wide at the surface, {} m deep", l.face_tiles(), l.depth_tiles(), tile, l.l_d());
+    println!(
+        "grid         {} tiles per face side, {} deep; tiles about {:.2} m wide at the surface, {} m deep",
+        l.face_tiles(),
+        l.depth_tiles(),
+        tile,
+        l.l_d()
+    );
     match t.sea_radius {
         Some(s) => println!("sea          radius {s:.2} m ({:.2} m above the base)", s - l.d_b()),
         None => println!("sea          none"),
     }
     if let Some((a, b)) = bounds {
-        println!("surface      between radius {a:.2} and {b:.2} m; {candidate} of {} chunks may hold it", l.chunk_count());
+        println!(
+            "surface      between radius {a:.2} and {b:.2} m; {candidate} of {} chunks may hold it",
+            l.chunk_count()
+        );
     }
     println!("materials    {}", t.materials.join(", "));
     Ok(())

@@ -5,6 +5,7 @@ mod error;
 mod generate;
 mod info;
 mod planet_args;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -23,6 +24,8 @@ enum Command {
     Generate(generate::GenerateArgs),
     /// Print the layout (chunk and voxel counts, radius: seed 000 Eq. 2-4) and the terrain.
     Info(info::InfoArgs),
+    /// Render a picture of a planet to a PNG file.
+    Render(render::RenderArgs),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +33,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Generate(a) => generate::run(a),
         Command::Info(a) => info::run(a),
+        Command::Render(a) => render::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

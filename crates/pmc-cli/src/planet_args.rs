@@ -26,11 +26,21 @@ pub struct PlanetArgs {
     pub n_t: u32,
 
     /// d_b: base depth, the radius in metres of the innermost voxel layer (at least l_d).
-    #[arg(long = "d-b", default_value_t = 1744.0, value_name = "METRES", allow_negative_numbers = true)]
+    #[arg(
+        long = "d-b",
+        default_value_t = 1744.0,
+        value_name = "METRES",
+        allow_negative_numbers = true
+    )]
     pub d_b: f64,
 
     /// l_d: length of a depth (radial) tile edge in metres, above 0.
-    #[arg(long = "l-d", default_value_t = 4.0, value_name = "METRES", allow_negative_numbers = true)]
+    #[arg(
+        long = "l-d",
+        default_value_t = 4.0,
+        value_name = "METRES",
+        allow_negative_numbers = true
+    )]
     pub l_d: f64,
 
     /// d_c: chunks along the depth axis. The planet radius is d_b + l_d * n_t * d_c.

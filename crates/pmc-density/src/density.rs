@@ -20,8 +20,11 @@ pub trait Density: Send + Sync {
     /// `out[r * dirs.len() + d]`.
     ///
     /// Sources override this to share work along a column (a height field is evaluated once per
-    /// direction, not once per voxel). The result must equal, bit for bit, what
-    /// [`Density::density`] gives for the same point: chunks sampled by either path agree.
+    /// direction, not once per voxel). The result must agree with [`Density::density`] up to the
+    /// rounding of the direction (a point call has to normalise `p`, which may differ from the
+    /// batch's unit direction in the last bit). Chunks always sample through this call with
+    /// canonical directions, so voxels shared by several chunks get identical values.
+    /// Must be deterministic: the same inputs give the same bits.
     ///
     /// # Panics
     /// If `out.len() != dirs.len() * radii.len()`.
@@ -150,7 +153,10 @@ mod tests {
 
     #[test]
     fn batch_matches_point_calls() {
-        let s = Union(Sphere { radius: 10.0 }, FnDensity(|p: DVec3| 3.0 - (p - DVec3::X * 10.0).length()));
+        let s = Union(
+            Sphere { radius: 10.0 },
+            FnDensity(|p: DVec3| 3.0 - (p - DVec3::X * 10.0).length()),
+        );
         let dirs = [DVec3::X, DVec3::Y, DVec3::new(0.6, 0.8, 0.0)];
         let radii = [5.0, 9.5, 10.0, 12.0];
         let mut out = vec![0.0; 12];

@@ -54,7 +54,11 @@ impl ChunkGrid {
         let padded = tiles + 3;
         let stride = key.stride();
         let span = tiles as i64 * stride;
-        let (i0, j0, k0) = (i64::from(key.i) * span, i64::from(key.j) * span, i64::from(key.k) * span);
+        let (i0, j0, k0) = (
+            i64::from(key.i) * span,
+            i64::from(key.j) * span,
+            i64::from(key.k) * span,
+        );
         let mut dirs = Vec::with_capacity(padded * padded);
         let mut lattice = Vec::with_capacity(padded * padded);
         let mut valid = Vec::with_capacity(padded * padded);
@@ -74,7 +78,9 @@ impl ChunkGrid {
                         // Past a cube corner: no voxel. Keep a harmless direction (the clamped
                         // corner) so batch density calls stay finite; the mesher never reads it.
                         let n = layout.face_tiles();
-                        let l = layout.lattice(key.face, i.clamp(0, n), j.clamp(0, n)).expect("clamped index is on the face");
+                        let l = layout
+                            .lattice(key.face, i.clamp(0, n), j.clamp(0, n))
+                            .expect("clamped index is on the face");
                         lattice.push(l);
                         dirs.push(layout.lattice_direction(l));
                         valid.push(false);
@@ -82,10 +88,25 @@ impl ChunkGrid {
                 }
             }
         }
-        let radii = (0..padded).map(|c| layout.layer_radius(k0 + (c as i64 - 1) * stride)).collect::<Vec<_>>();
+        let radii = (0..padded)
+            .map(|c| layout.layer_radius(k0 + (c as i64 - 1) * stride))
+            .collect::<Vec<_>>();
         let mid = padded / 2;
         let origin = dirs[mid * padded + mid] * radii[mid];
-        ChunkGrid { key, tiles, padded, stride, i0, j0, k0, dirs, lattice, valid, radii, origin }
+        ChunkGrid {
+            key,
+            tiles,
+            padded,
+            stride,
+            i0,
+            j0,
+            k0,
+            dirs,
+            lattice,
+            valid,
+            radii,
+            origin,
+        }
     }
 
     /// Number of padded samples, `padded^3`.
@@ -108,7 +129,10 @@ impl ChunkGrid {
     /// Canonical key of padded sample `(a, b, c)`.
     #[inline]
     pub fn voxel_key(&self, a: usize, b: usize, c: usize) -> VoxelKey {
-        VoxelKey::new(self.lattice[b * self.padded + a], (self.k0 + (c as i64 - 1) * self.stride) as i32)
+        VoxelKey::new(
+            self.lattice[b * self.padded + a],
+            (self.k0 + (c as i64 - 1) * self.stride) as i32,
+        )
     }
 
     /// The face of the chunk.

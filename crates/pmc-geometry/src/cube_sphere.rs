@@ -157,7 +157,18 @@ mod tests {
 
     #[test]
     fn round_trip_near_edges_and_corners() {
-        let vals = [-1.0, -1.0 + 1e-15, -0.999999, -0.5, 0.0, 1e-300, 0.5, 0.999999, 1.0 - 1e-15, 1.0];
+        let vals = [
+            -1.0,
+            -1.0 + 1e-15,
+            -0.999999,
+            -0.5,
+            0.0,
+            1e-300,
+            0.5,
+            0.999999,
+            1.0 - 1e-15,
+            1.0,
+        ];
         for f in Face::ALL {
             for &u in &vals {
                 for &v in &vals {

@@ -91,22 +91,53 @@ impl FaceFrame {
 
 const FRAMES: [FaceFrame; 6] = [
     // Top
-    FaceFrame { u: IVec3::new(-1, 0, 0), v: IVec3::new(0, 0, 1), n: IVec3::new(0, 1, 0) },
+    FaceFrame {
+        u: IVec3::new(-1, 0, 0),
+        v: IVec3::new(0, 0, 1),
+        n: IVec3::new(0, 1, 0),
+    },
     // Bottom
-    FaceFrame { u: IVec3::new(-1, 0, 0), v: IVec3::new(0, 0, -1), n: IVec3::new(0, -1, 0) },
+    FaceFrame {
+        u: IVec3::new(-1, 0, 0),
+        v: IVec3::new(0, 0, -1),
+        n: IVec3::new(0, -1, 0),
+    },
     // North
-    FaceFrame { u: IVec3::new(-1, 0, 0), v: IVec3::new(0, 1, 0), n: IVec3::new(0, 0, -1) },
+    FaceFrame {
+        u: IVec3::new(-1, 0, 0),
+        v: IVec3::new(0, 1, 0),
+        n: IVec3::new(0, 0, -1),
+    },
     // South
-    FaceFrame { u: IVec3::new(-1, 0, 0), v: IVec3::new(0, -1, 0), n: IVec3::new(0, 0, 1) },
+    FaceFrame {
+        u: IVec3::new(-1, 0, 0),
+        v: IVec3::new(0, -1, 0),
+        n: IVec3::new(0, 0, 1),
+    },
     // East
-    FaceFrame { u: IVec3::new(0, 1, 0), v: IVec3::new(0, 0, 1), n: IVec3::new(1, 0, 0) },
+    FaceFrame {
+        u: IVec3::new(0, 1, 0),
+        v: IVec3::new(0, 0, 1),
+        n: IVec3::new(1, 0, 0),
+    },
     // West
-    FaceFrame { u: IVec3::new(0, 0, 1), v: IVec3::new(0, 1, 0), n: IVec3::new(-1, 0, 0) },
+    FaceFrame {
+        u: IVec3::new(0, 0, 1),
+        v: IVec3::new(0, 1, 0),
+        n: IVec3::new(-1, 0, 0),
+    },
 ];
 
 impl Face {
     /// All six faces in index order.
-    pub const ALL: [Face; 6] = [Face::Top, Face::Bottom, Face::North, Face::South, Face::East, Face::West];
+    pub const ALL: [Face; 6] = [
+        Face::Top,
+        Face::Bottom,
+        Face::North,
+        Face::South,
+        Face::East,
+        Face::West,
+    ];
 
     /// The face's index, 0..6, in the order of [`Face::ALL`].
     pub fn index(self) -> usize {

@@ -78,20 +78,33 @@ impl FaceTransition {
                     let m = along_vec.dot(t);
                     if m != 0 {
                         // u_t = m y  =>  p_t = m p + (1 - m)/2 size
-                        return AxisMap { target: tgt, mul: m as i8, offset: ((1 - m) / 2) as i8 };
+                        return AxisMap {
+                            target: tgt,
+                            mul: m as i8,
+                            offset: ((1 - m) / 2) as i8,
+                        };
                     }
                 } else {
                     let tau = fc.n.dot(t);
                     if tau != 0 {
                         // u_t = 2 tau - tau sigma x  =>  p_t = m p + (2 tau - m + 1)/2 size
                         let m = -tau * sigma;
-                        return AxisMap { target: tgt, mul: m as i8, offset: ((2 * tau - m + 1) / 2) as i8 };
+                        return AxisMap {
+                            target: tgt,
+                            mul: m as i8,
+                            offset: ((2 * tau - m + 1) / 2) as i8,
+                        };
                     }
                 }
             }
             unreachable!("adjacent faces always share an axis direction")
         };
-        Some(FaceTransition { from, to, u: map_axis(FaceAxis::U), v: map_axis(FaceAxis::V) })
+        Some(FaceTransition {
+            from,
+            to,
+            u: map_axis(FaceAxis::U),
+            v: map_axis(FaceAxis::V),
+        })
     }
 
     /// The axis map for the current face's `axis`.
@@ -200,8 +213,22 @@ mod tests {
     fn top_to_south_is_a_plain_offset() {
         // Fig. 7 left: Top and South have compatible axes; only the origin differs by one face.
         let t = FaceTransition::new(Face::Top, Face::South).unwrap();
-        assert_eq!(t.u, AxisMap { target: FaceAxis::U, mul: 1, offset: 0 });
-        assert_eq!(t.v, AxisMap { target: FaceAxis::V, mul: 1, offset: -1 });
+        assert_eq!(
+            t.u,
+            AxisMap {
+                target: FaceAxis::U,
+                mul: 1,
+                offset: 0
+            }
+        );
+        assert_eq!(
+            t.v,
+            AxisMap {
+                target: FaceAxis::V,
+                mul: 1,
+                offset: -1
+            }
+        );
         // Fig. 7 right: crossing onto a cap face swaps the axes.
         let t = FaceTransition::new(Face::Top, Face::West).unwrap();
         assert_eq!((t.u.target, t.v.target), (FaceAxis::V, FaceAxis::U));
@@ -217,10 +244,19 @@ mod tests {
             let nb = b.normal();
             for k in 0..=8 {
                 let lam = S * f64::from(k) / 8.0;
-                for (s, t, ds, dt) in [(S, lam, 1.0, 0.0), (0.0, lam, -1.0, 0.0), (lam, S, 0.0, 1.0), (lam, 0.0, 0.0, -1.0)] {
+                for (s, t, ds, dt) in [
+                    (S, lam, 1.0, 0.0),
+                    (0.0, lam, -1.0, 0.0),
+                    (lam, S, 0.0, 1.0),
+                    (lam, 0.0, 0.0, -1.0),
+                ] {
                     let c = cube(a, s, t);
                     // Only the side whose whole edge lies on b's plane (its midpoint does).
-                    let mid = cube(a, if ds == 0.0 { S / 2.0 } else { s }, if dt == 0.0 { S / 2.0 } else { t });
+                    let mid = cube(
+                        a,
+                        if ds == 0.0 { S / 2.0 } else { s },
+                        if dt == 0.0 { S / 2.0 } else { t },
+                    );
                     if (mid.dot(nb) - 1.0).abs() > 1e-12 {
                         continue;
                     }

@@ -29,7 +29,13 @@ pub struct ChunkKey {
 impl ChunkKey {
     /// A level-0 chunk key.
     pub fn new(face: Face, i: u32, j: u32, k: u32) -> ChunkKey {
-        ChunkKey { face, level: 0, i, j, k }
+        ChunkKey {
+            face,
+            level: 0,
+            i,
+            j,
+            k,
+        }
     }
 
     /// The sample stride of this chunk's level, in level-0 grid steps.
@@ -60,7 +66,10 @@ pub struct VoxelKey {
 impl VoxelKey {
     /// Builds a key from a lattice point and a depth index.
     pub fn new(lattice: IVec3, k: i32) -> VoxelKey {
-        VoxelKey { lattice: lattice.to_array(), k }
+        VoxelKey {
+            lattice: lattice.to_array(),
+            k,
+        }
     }
 
     /// Packs the key into 128 bits (lattice components must lie within +-2^30, as every

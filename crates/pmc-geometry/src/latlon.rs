@@ -60,7 +60,10 @@ impl LatLon {
         let h = p.x.hypot(p.z);
         let lat = p.y.atan2(h).to_degrees();
         let lon = if h == 0.0 { 0.0 } else { p.x.atan2(p.z).to_degrees() };
-        Some(LatLon { lat, lon: if lon == -180.0 { 180.0 } else { lon } })
+        Some(LatLon {
+            lat,
+            lon: if lon == -180.0 { 180.0 } else { lon },
+        })
     }
 }
 

@@ -36,7 +36,9 @@ pub enum LayoutError {
         l_d: f64,
     },
     /// `n_c * n_t` or `n_t * d_c` is above 2^24 tiles.
-    #[error("the layout has {0} tiles along one axis, more than the supported {MAX_AXIS_TILES}; lower n_c, n_t or d_c")]
+    #[error(
+        "the layout has {0} tiles along one axis, more than the supported {MAX_AXIS_TILES}; lower n_c, n_t or d_c"
+    )]
     TooLarge(u64),
 }
 
@@ -85,7 +87,13 @@ impl Layout {
         if face > MAX_AXIS_TILES || depth > MAX_AXIS_TILES {
             return Err(LayoutError::TooLarge(face.max(depth)));
         }
-        Ok(Layout { n_c, n_t, d_b, l_d, d_c })
+        Ok(Layout {
+            n_c,
+            n_t,
+            d_b,
+            l_d,
+            d_c,
+        })
     }
 
     /// `n_c`: chunks along each side of a face.
@@ -280,11 +288,26 @@ mod tests {
         assert_eq!(Layout::new(0, 8, 10.0, 1.0, 1), Err(LayoutError::ChunksPerSide(0)));
         assert_eq!(Layout::new(1, 0, 10.0, 1.0, 1), Err(LayoutError::TilesPerChunk(0)));
         assert_eq!(Layout::new(1, 8, 10.0, 1.0, 0), Err(LayoutError::DepthChunks(0)));
-        assert!(matches!(Layout::new(1, 8, 10.0, f64::NAN, 1), Err(LayoutError::TileDepth(_))));
-        assert!(matches!(Layout::new(1, 8, 10.0, -1.0, 1), Err(LayoutError::TileDepth(_))));
-        assert!(matches!(Layout::new(1, 8, f64::NAN, 1.0, 1), Err(LayoutError::BaseDepth { .. })));
-        assert!(matches!(Layout::new(1, 8, -5.0, 1.0, 1), Err(LayoutError::BaseDepth { .. })));
-        assert!(matches!(Layout::new(1 << 20, 256, 10.0, 1.0, 1), Err(LayoutError::TooLarge(_))));
+        assert!(matches!(
+            Layout::new(1, 8, 10.0, f64::NAN, 1),
+            Err(LayoutError::TileDepth(_))
+        ));
+        assert!(matches!(
+            Layout::new(1, 8, 10.0, -1.0, 1),
+            Err(LayoutError::TileDepth(_))
+        ));
+        assert!(matches!(
+            Layout::new(1, 8, f64::NAN, 1.0, 1),
+            Err(LayoutError::BaseDepth { .. })
+        ));
+        assert!(matches!(
+            Layout::new(1, 8, -5.0, 1.0, 1),
+            Err(LayoutError::BaseDepth { .. })
+        ));
+        assert!(matches!(
+            Layout::new(1 << 20, 256, 10.0, 1.0, 1),
+            Err(LayoutError::TooLarge(_))
+        ));
     }
 
     /// Face-edge and corner voxels get one key whichever face names them.

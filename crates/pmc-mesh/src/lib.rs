@@ -12,7 +12,9 @@ mod chunk_mesh;
 mod mesher;
 pub mod shell;
 pub mod tables;
+pub mod topology;
 
 pub use chunk_mesh::ChunkMesh;
 pub use mesher::{is_solid, Mesher};
 pub use shell::close_shell;
+pub use topology::{ManifoldReport, WeldedMesh};

@@ -47,7 +47,11 @@ impl Mesher {
     /// # Panics
     /// If `densities.len() != grid.sample_count()`.
     pub fn mesh(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
-        assert_eq!(densities.len(), grid.sample_count(), "densities must cover the padded chunk grid");
+        assert_eq!(
+            densities.len(),
+            grid.sample_count(),
+            "densities must cover the padded chunk grid"
+        );
         out.clear();
         out.key = Some(grid.key);
         out.origin = grid.origin;
@@ -75,7 +79,12 @@ impl Mesher {
             [1.0 / grid.radii[c], 1.0 / dr]
         }));
         let tables = &*TABLES;
-        let mut ctx = Ctx { grid, densities, mesher: self, out };
+        let mut ctx = Ctx {
+            grid,
+            densities,
+            mesher: self,
+            out,
+        };
         if p <= 128 {
             march_bit_rows(&mut ctx, tables);
         } else {
@@ -268,7 +277,8 @@ impl Ctx<'_> {
         let idx = out.positions.len() as u32;
         out.positions.push(rel.as_vec3().to_array());
         out.normals.push(normal.to_array());
-        out.edge_keys.push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
+        out.edge_keys
+            .push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
         idx
     }
 

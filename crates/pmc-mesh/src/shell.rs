@@ -19,19 +19,23 @@ pub const FORCED_AIR: f32 = -1.0;
 /// # Panics
 /// If `densities.len() != grid.sample_count()`.
 pub fn close_shell(grid: &ChunkGrid, depth_tiles: i64, densities: &mut [f32]) {
-    assert_eq!(densities.len(), grid.sample_count(), "densities must cover the padded chunk grid");
+    assert_eq!(
+        densities.len(),
+        grid.sample_count(),
+        "densities must cover the padded chunk grid"
+    );
     let layer = grid.padded * grid.padded;
     for (c, slab) in densities.chunks_exact_mut(layer).enumerate() {
         let k = grid.k0 + (c as i64 - 1) * grid.stride;
         if k <= 0 {
             for d in slab.iter_mut() {
-                if !(*d > 0.0) {
+                if !crate::is_solid(*d) {
                     *d = FORCED_SOLID;
                 }
             }
         } else if k >= depth_tiles {
             for d in slab.iter_mut() {
-                if !(*d <= 0.0) {
+                if d.is_nan() || *d > 0.0 {
                     *d = FORCED_AIR;
                 }
             }

@@ -16,8 +16,20 @@
 use std::sync::LazyLock;
 
 /// The two corners of each of the 12 cube edges, lower corner first.
-pub const EDGE_CORNERS: [(u8, u8); 12] =
-    [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
+pub const EDGE_CORNERS: [(u8, u8); 12] = [
+    (0, 1),
+    (2, 3),
+    (4, 5),
+    (6, 7),
+    (0, 2),
+    (1, 3),
+    (4, 6),
+    (5, 7),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
 
 /// The axis (0 = x, 1 = y, 2 = z) of each cube edge.
 pub const EDGE_AXIS: [u8; 12] = [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2];
@@ -77,7 +89,10 @@ fn faces() -> [[u8; 4]; 6] {
 
 fn edge_between(a: u8, b: u8) -> u8 {
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-    EDGE_CORNERS.iter().position(|e| *e == (lo, hi)).expect("corners share an edge") as u8
+    EDGE_CORNERS
+        .iter()
+        .position(|e| *e == (lo, hi))
+        .expect("corners share an edge") as u8
 }
 
 fn edge_midpoint(e: u8) -> [f64; 3] {
@@ -143,7 +158,9 @@ fn edges_share_face(a: u8, b: u8, faces: &[[u8; 4]; 6]) -> bool {
 fn triangulate(lp: &[u8], faces: &[[u8; 4]; 6], flip: bool, out: &mut Vec<[u8; 3]>) {
     let m = lp.len();
     let bad = |apex: usize| {
-        (2..m - 1).filter(|&k| edges_share_face(lp[apex], lp[(apex + k) % m], faces)).count()
+        (2..m - 1)
+            .filter(|&k| edges_share_face(lp[apex], lp[(apex + k) % m], faces))
+            .count()
     };
     let apex = (0..m).min_by_key(|&a| bad(a)).unwrap_or(0);
     for k in 1..m - 1 {
@@ -182,7 +199,11 @@ fn generate() -> McTables {
         }
         ranges[case as usize + 1] = triangles.len() as u16;
     }
-    McTables { ranges, triangles, edge_masks }
+    McTables {
+        ranges,
+        triangles,
+        edge_masks,
+    }
 }
 
 #[cfg(test)]
@@ -232,7 +253,10 @@ mod tests {
                 let back = count.get(&(b, a)).copied().unwrap_or(0);
                 assert_eq!(n, 1, "case {c}: directed edge {a}->{b} used {n} times");
                 if back == 0 {
-                    assert!(edges_share_face(a, b, &faces), "case {c}: open edge {a}-{b} off the faces");
+                    assert!(
+                        edges_share_face(a, b, &faces),
+                        "case {c}: open edge {a}-{b} off the faces"
+                    );
                 }
             }
         }
@@ -250,7 +274,7 @@ mod tests {
                 let o = corner_offset(k);
                 let tgt = if c & (1 << k) != 0 { &mut s } else { &mut a };
                 for i in 0..3 {
-                    tgt[i] += o[i] as f64 * if c & (1 << k) != 0 { 1.0 } else { 1.0 };
+                    tgt[i] += o[i] as f64;
                 }
             }
             let ns = c.count_ones() as f64;

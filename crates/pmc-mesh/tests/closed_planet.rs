@@ -5,7 +5,7 @@
 use pmc_density::{Density, FnDensity, Sphere};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkGrid, EdgeKey, Layout};
-use pmc_mesh::{close_shell, ChunkMesh, Mesher};
+use pmc_mesh::{close_shell, ChunkMesh, Mesher, WeldedMesh};
 use proptest::prelude::*;
 use std::collections::HashMap;
 
@@ -25,50 +25,10 @@ fn mesh_planet(layout: &Layout, density: &dyn Density) -> Vec<ChunkMesh> {
     out
 }
 
-struct Welded {
-    vertices: Vec<DVec3>,
-    triangles: Vec<[usize; 3]>,
-}
-
-fn weld(meshes: &[ChunkMesh]) -> Welded {
-    let mut ids: HashMap<EdgeKey, usize> = HashMap::new();
-    let mut vertices = Vec::new();
-    let mut triangles = Vec::new();
-    for m in meshes {
-        let local: Vec<usize> = (0..m.vertex_count())
-            .map(|i| {
-                *ids.entry(m.edge_keys[i]).or_insert_with(|| {
-                    vertices.push(m.world_position(i));
-                    vertices.len() - 1
-                })
-            })
-            .collect();
-        for t in m.indices.chunks_exact(3) {
-            triangles.push([local[t[0] as usize], local[t[1] as usize], local[t[2] as usize]]);
-        }
-    }
-    Welded { vertices, triangles }
-}
-
-/// Checks the closed-manifold property; returns the Euler characteristic.
-fn check_closed(w: &Welded) -> i64 {
-    let mut directed: HashMap<(usize, usize), u32> = HashMap::new();
-    for t in &w.triangles {
-        assert!(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "collapsed triangle {t:?}");
-        for k in 0..3 {
-            *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
-        }
-    }
-    for (&(a, b), &n) in &directed {
-        assert_eq!(n, 1, "directed edge {a}->{b} used {n} times (non-manifold or flipped)");
-        assert_eq!(directed.get(&(b, a)), Some(&1), "boundary edge {a}-{b}: the surface is open");
-    }
-    let e = directed.len() as i64 / 2;
-    w.vertices.len() as i64 - e + w.triangles.len() as i64
-}
-
-fn volume(w: &Welded) -> f64 {
-    w.triangles.iter().map(|t| w.vertices[t[0]].dot(w.vertices[t[1]].cross(w.vertices[t[2]])) / 6.0).sum()
+fn check_closed(w: &WeldedMesh) -> i64 {
+    let r = w.report();
+    assert!(r.is_closed_manifold(), "not a closed manifold: {r:?}");
+    r.euler_characteristic()
 }
 
 #[test]
@@ -76,14 +36,18 @@ fn sphere_is_closed_with_euler_2_and_the_right_volume() {
     let layout = Layout::new(4, 16, 60.0, 1.0, 2).unwrap();
     let r = 60.0 + 16.37;
     let meshes = mesh_planet(&layout, &Sphere { radius: r });
-    let w = weld(&meshes);
+    let w = WeldedMesh::weld(&meshes);
     assert_eq!(check_closed(&w), 2);
     let exact = 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
-    let v = volume(&w);
+    let v = w.volume();
     assert!((v - exact).abs() / exact < 0.005, "volume {v} vs {exact}");
     // Every vertex lies on the sphere: radial edges cut it exactly.
-    for p in &w.vertices {
-        assert!((p.length() - r).abs() < 1e-3, "vertex off the sphere by {}", p.length() - r);
+    for p in &w.positions {
+        assert!(
+            (p.length() - r).abs() < 1e-3,
+            "vertex off the sphere by {}",
+            p.length() - r
+        );
     }
 }
 
@@ -101,7 +65,9 @@ fn normals_agree_across_chunk_and_face_borders() {
             let bits = [wp.x as f32, wp.y as f32, wp.z as f32].map(f32::to_bits);
             if let Some((pb, pn)) = seen.insert(m.edge_keys[i], (bits, n)) {
                 shared += 1;
-                let dp: Vec<f32> = (0..3).map(|k| (f32::from_bits(pb[k]) - f32::from_bits(bits[k])).abs()).collect();
+                let dp: Vec<f32> = (0..3)
+                    .map(|k| (f32::from_bits(pb[k]) - f32::from_bits(bits[k])).abs())
+                    .collect();
                 assert!(dp.iter().all(|d| *d < 1e-3), "shared vertex moved: {dp:?}");
                 let dot = pn[0] * n[0] + pn[1] * n[1] + pn[2] * n[2];
                 assert!(dot > 0.99, "shared vertex normals disagree: {pn:?} vs {n:?}");
@@ -133,7 +99,7 @@ proptest! {
         let mid = 20.0 + f64::from(n_t * d_c) * 0.5;
         let f = FnDensity(rough_field(seed, scale, mid));
         let meshes = mesh_planet(&layout, &f);
-        let w = weld(&meshes);
+        let w = WeldedMesh::weld(&meshes);
         prop_assert!(!w.triangles.is_empty());
         check_closed(&w);
     }

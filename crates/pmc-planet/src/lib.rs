@@ -18,5 +18,5 @@
 
 mod planet;
 
-pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};
 pub use planet::{ChunkScratch, Planet};
+pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};

@@ -49,7 +49,9 @@ impl Planet {
     /// The radius heights are measured from: the sea surface when the planet has a sea, else the
     /// middle of the shell.
     pub fn datum_radius(&self) -> f64 {
-        self.terrain.sea_radius.unwrap_or_else(|| 0.5 * (self.layout.d_b() + self.layout.radius()))
+        self.terrain
+            .sea_radius
+            .unwrap_or_else(|| 0.5 * (self.layout.d_b() + self.layout.radius()))
     }
 
     /// Whether a chunk may hold surface, judged from the terrain's radial bounds and the shell
@@ -89,7 +91,9 @@ impl Planet {
             return;
         }
         scratch.densities.resize(grid.sample_count(), 0.0);
-        self.terrain.density.sample_shell(&grid.dirs, &grid.radii, &mut scratch.densities);
+        self.terrain
+            .density
+            .sample_shell(&grid.dirs, &grid.radii, &mut scratch.densities);
         close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
         scratch.mesher.mesh(&grid, &scratch.densities, out);
         self.shade(out);

@@ -1,0 +1,95 @@
+//! `pmc render`: a picture of a planet (PNG), from orbit or close to the ground.
+
+use crate::error::CliError;
+use crate::planet_args::PlanetArgs;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pmc_render::{Camera, RenderOptions};
+use std::path::PathBuf;
+
+/// Options of `pmc render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    planet: PlanetArgs,
+
+    /// Output PNG file.
+    #[arg(short = 'o', long = "output", default_value = "planet.png", value_name = "PATH")]
+    output: PathBuf,
+
+    /// Latitude of the camera, degrees.
+    #[arg(long, default_value_t = 25.0, allow_negative_numbers = true)]
+    lat: f64,
+
+    /// Longitude of the camera, degrees.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    lon: f64,
+
+    /// Camera distance from the planet centre in metres; by default the planet fills the frame.
+    #[arg(long, value_name = "METRES")]
+    distance: Option<f64>,
+
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 800)]
+    height: u32,
+
+    /// Worker threads; 0 uses every core.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    threads: usize,
+
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Runs `pmc render`.
+pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let planet = args.planet.planet()?;
+    let ext_ok = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !ext_ok {
+        return Err(CliError::Output {
+            path: args.output.clone(),
+            reason: "pictures are written as PNG: use a .png name".into(),
+        });
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .map_err(|e| CliError::Threads {
+            threads: args.threads,
+            reason: e.to_string(),
+        })?;
+    let total = planet.layout().chunk_count();
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} meshing chunks {bar:40} {pos}/{len} ({elapsed})")
+            .expect("valid template"),
+    );
+    let meshes = pool.install(|| planet.generate(|_| bar.inc(1)));
+    bar.finish_and_clear();
+    let radius = planet.layout().radius();
+    let camera = match args.distance {
+        Some(d) => Camera::orbit(args.lat, args.lon, d),
+        None => Camera::framing(args.lat, args.lon, radius),
+    };
+    let opts = RenderOptions {
+        width: args.width,
+        height: args.height,
+        sea_radius: planet.terrain().sea_radius,
+        ..Default::default()
+    };
+    let image = pool.install(|| pmc_render::render(&meshes, &camera, &opts))?;
+    image.write_png(&args.output)?;
+    if !args.quiet {
+        eprintln!("wrote {} ({}x{})", args.output.display(), args.width, args.height);
+    }
+    Ok(())
+}

@@ -1,0 +1,146 @@
+//! The `pmc` command as a user runs it: outputs, determinism, and clear errors on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn pmc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pmc"))
+        .args(args)
+        .output()
+        .expect("pmc runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pmc-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+const SMALL: [&str; 8] = ["--n-c", "2", "--n-t", "8", "--d-b", "200", "--l-d", "2"];
+
+fn assert_refused(args: &[&str], needle: &str) {
+    let o = pmc(args);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{args:?} should fail");
+    assert!(!e.contains("panicked"), "{args:?} panicked: {e}");
+    assert!(e.contains(needle), "{args:?}: expected '{needle}' in: {e}");
+}
+
+#[test]
+fn info_prints_the_paper_formulas() {
+    let o = pmc(&[
+        "info", "--preset", "sphere", "--n-c", "4", "--n-t", "16", "--d-b", "100", "--l-d", "2", "--d-c", "3",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = String::from_utf8(o.stdout).unwrap();
+    assert!(s.contains("chunks       288 "), "{s}");
+    assert!(s.contains(&format!("voxels       {} ", 6 * 65 * 65 * 49)), "{s}");
+    assert!(s.contains("radius       196 m"), "{s}");
+    let o = pmc(&["info", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["chunks"], 768);
+    assert_eq!(v["radius"], 2000.0);
+    assert_eq!(v["preset"], "earthlike");
+}
+
+#[test]
+fn generate_writes_a_glb_and_is_deterministic_across_thread_counts() {
+    let a = tmp("a.glb");
+    let b = tmp("b.glb");
+    let mut args1 = vec![
+        "generate",
+        "--quiet",
+        "--preset",
+        "earthlike",
+        "--seed",
+        "11",
+        "--threads",
+        "1",
+        "-o",
+    ];
+    args1.push(a.to_str().unwrap());
+    args1.extend(SMALL);
+    let o = pmc(&args1);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut args2 = vec![
+        "generate",
+        "--quiet",
+        "--preset",
+        "earthlike",
+        "--seed",
+        "11",
+        "--threads",
+        "2",
+        "-o",
+    ];
+    args2.push(b.to_str().unwrap());
+    args2.extend(SMALL);
+    assert!(pmc(&args2).status.success());
+    let (x, y) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_eq!(&x[0..4], b"glTF");
+    assert!(x.len() > 10_000);
+    assert!(x == y, "output differs between 1 and 2 threads");
+}
+
+#[test]
+fn every_format_is_written() {
+    for ext in ["glb", "obj", "ply"] {
+        let p = tmp(&format!("sphere.{ext}"));
+        let mut args = vec!["generate", "--quiet", "--preset", "sphere", "-o", p.to_str().unwrap()];
+        args.extend(SMALL);
+        let o = pmc(&args);
+        assert!(o.status.success(), "{ext}: {}", stderr(&o));
+        assert!(std::fs::metadata(&p).unwrap().len() > 1000, "{ext} too small");
+    }
+}
+
+#[test]
+fn invalid_parameters_are_refused_clearly() {
+    assert_refused(&["generate", "--n-t", "0"], "n_t");
+    assert_refused(&["generate", "--n-c", "0"], "n_c");
+    assert_refused(&["generate", "--d-c", "0"], "d_c");
+    assert_refused(&["generate", "--d-b", "NaN"], "d_b");
+    assert_refused(&["generate", "--d-b", "-5"], "d_b");
+    assert_refused(&["generate", "--l-d", "-1"], "l_d");
+    assert_refused(&["generate", "--l-d", "inf"], "l_d");
+    assert_refused(&["generate", "--preset", "venus"], "unknown preset 'venus'");
+    assert_refused(&["generate", "--seed", "-3"], "-3");
+    assert_refused(&["generate", "--seed", "x"], "--seed");
+    assert_refused(&["info", "--n-t", "100000"], "n_t");
+}
+
+#[test]
+fn unwritable_outputs_are_refused_before_any_work() {
+    assert_refused(&["generate", "-o", "/nonexistent-dir/planet.glb"], "does not exist");
+    assert_refused(&["generate", "-o", "planet.stl"], "planet.stl");
+    assert_refused(&["generate", "-o", "planet"], "planet");
+    let dir = tmp("adir.glb");
+    std::fs::create_dir_all(&dir).unwrap();
+    assert_refused(&["generate", "-o", dir.to_str().unwrap()], "directory");
+    assert!(!Path::new("planet.stl").exists());
+}
+
+#[test]
+fn help_explains_every_option() {
+    let o = pmc(&["generate", "--help"]);
+    let s = String::from_utf8(o.stdout).unwrap();
+    for opt in [
+        "--preset",
+        "--seed",
+        "--n-c",
+        "--n-t",
+        "--d-b",
+        "--l-d",
+        "--d-c",
+        "--output",
+        "--threads",
+        "--quiet",
+    ] {
+        assert!(s.contains(opt), "--help lacks {opt}");
+    }
+    assert!(s.contains("earthlike") && s.contains("moon") && s.contains("mars"));
+}

@@ -1,0 +1,486 @@
+//! The earthlike preset: continents and seas, coastal plains, ridged mountain belts, spaghetti
+//! caves above sea level and overhangs in the mountains.
+//!
+//! Relief is set in fractions of the shell thickness `T`, horizontal scales relative to the
+//! planet radius (height noise is 3D noise at the unit direction times a frequency) or in tiles,
+//! cave and overhang depths in voxel depths `l_d`. Heights below are above the sea radius
+//! `d_b + 0.55 T`:
+//!
+//! | feature            | height                            | horizontal scale             |
+//! |--------------------|-----------------------------------|------------------------------|
+//! | ocean floor        | down to -0.23 T (shelf, then deep) | continents, 1.4 cells/radian |
+//! | lowlands           | up to +0.07 T inland               | continents                   |
+//! | hills              | +-0.03 T on land, +-0.015 T at sea | 0.1 R down to 2 tiles        |
+//! | mountain belts     | up to +0.24 T (ridged)             | belts 2 cells/radian, ridges 0.16 R |
+//! | overhangs          | displacement up to 4 `l_d` (at most 0.065 T), on steep mountain slopes | 3 tiles across, 3 `l_d` deep |
+//! | caves              | band from sea level + `l_d` to 2.5 `l_d` under the surface, at most 0.14 T deep; the roof opens in places (cave mouths) | tubes about 2 tiles wide and 3 `l_d` tall, about 12 tiles apart |
+
+use super::features::{lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, Overhang, Scales, Spaghetti};
+use super::shading::{Material, Palette};
+use super::{PresetKind, Shade, Shader, Terrain};
+use crate::noise::{derive_seed, gradient3, Fbm, FbmParams, Ridged, RidgedParams};
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::Layout;
+use std::sync::Arc;
+
+/// Material names, indexed by [`Shade::material`].
+pub(crate) const MATERIALS: &[&str] = &["sand", "grass", "forest", "rock", "snow", "cave"];
+const SAND: u8 = 0;
+const GRASS: u8 = 1;
+const FOREST: u8 = 2;
+const ROCK: u8 = 3;
+const SNOW: u8 = 4;
+const CAVE: u8 = 5;
+
+/// Sea radius, as a fraction of the shell above `d_b`.
+pub(crate) const SEA_LEVEL: f64 = 0.55;
+/// Depth of the continental shelf (fraction of `T`).
+const SHELF_DEPTH: f64 = 0.03;
+/// Extra depth of the deep ocean beyond the shelf (fraction of `T`).
+const OCEAN_DEPTH: f64 = 0.20;
+/// Rise of the lowlands from the coast inland (fraction of `T`).
+const LOWLAND_RISE: f64 = 0.07;
+/// Hill amplitude on land and at sea (fractions of `T`; the fBm is doubled, so this is about
+/// its typical excursion and half its bound).
+const HILLS_LAND: f64 = 0.03;
+const HILLS_SEA: f64 = 0.015;
+/// Height of the mountain ridges (fraction of `T`).
+const MOUNTAIN_HEIGHT: f64 = 0.24;
+/// Continents: noise cells per unit of direction, and the offset that sets the land fraction.
+const CONTINENT_FREQ: f64 = 1.4;
+const CONTINENT_BIAS: f64 = -0.02;
+/// Mountain belts: cells per unit of direction.
+const BELT_FREQ: f64 = 2.0;
+/// Hills: largest wavelength (fraction of the radius).
+const HILLS_WAVELENGTH: f64 = 0.1;
+/// Ridges: largest wavelength (fraction of the radius).
+const RIDGE_WAVELENGTH: f64 = 0.16;
+/// Overhang displacement: amplitude in `l_d` (at most 6.5% of `T`), noise lengths in tiles across
+/// and `l_d` deep.
+const OVERHANG_AMPLITUDE: f64 = 4.0;
+const OVERHANG_ACROSS: f64 = 3.0;
+const OVERHANG_DEEP: f64 = 3.0;
+/// Caves: tube noise lengths (tiles across, `l_d` deep), threshold, band depth (fraction of `T`),
+/// roof thickness (`l_d`), region size (tiles).
+const CAVE_ACROSS: f64 = 12.0;
+const CAVE_DEEP: f64 = 14.0;
+const CAVE_THRESHOLD: f64 = 0.1;
+const CAVE_BAND: f64 = 0.14;
+const CAVE_ROOF: f64 = 2.5;
+const CAVE_REGION: f64 = 40.0;
+/// How fast the cave field closes outside its band (density per metre).
+const CAVE_SLOPE: f64 = 8.0;
+
+/// Everything a column of the earthlike planet computes once.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EarthColumn {
+    /// Surface radius of the height field (before overhang displacement).
+    pub h: f64,
+    /// Overhang displacement amplitude (metres).
+    pub amp: f64,
+    /// Where caves may open.
+    pub band: CaveBand,
+    /// Mountain mask in `[0, 1]`.
+    pub mountains: f64,
+}
+
+/// The earthlike density model.
+pub(crate) struct EarthModel {
+    s: Scales,
+    sea: f64,
+    continents: Fbm,
+    belts: Fbm,
+    hills: Fbm,
+    ridges: Ridged,
+    region_seed: u64,
+    region_freq: f64,
+    overhang: Overhang,
+    overhang_amp: f64,
+    caves: Spaghetti,
+    bounds: (f64, f64),
+}
+
+impl EarthModel {
+    pub(crate) fn new(seed: u64, layout: &Layout) -> Self {
+        let s = Scales::new(layout);
+        let t = s.thickness;
+        let sea = s.shell(SEA_LEVEL);
+        let fine = 2.0 * s.tile;
+        let cont_oct = s.octaves(s.radius / CONTINENT_FREQ, 10.0 * s.tile, 6);
+        let hills_oct = s.octaves(HILLS_WAVELENGTH * s.radius, fine, 12);
+        let ridge_oct = s.octaves(RIDGE_WAVELENGTH * s.radius, fine, 12);
+        let overhang_amp = (OVERHANG_AMPLITUDE * s.l_d).min(0.065 * t);
+        let caves = Spaghetti::new(
+            (derive_seed(seed, 20), derive_seed(seed, 21)),
+            CAVE_ACROSS * s.tile,
+            (CAVE_DEEP * s.l_d).min(0.25 * t),
+            sea,
+            CAVE_THRESHOLD,
+            CAVE_SLOPE,
+            t,
+        );
+        // Bounds: every term at its extreme (noise is within [-1, 1], masks within [0, 1]); ocean
+        // and land terms exclude each other, overhangs only occur on land (e > 0.015, where the
+        // height is at least sea - 2 HILLS_LAND T).
+        let hills_max = 2.0 * HILLS_LAND * t;
+        let lowest_floor = sea - (SHELF_DEPTH + OCEAN_DEPTH) * t - hills_max;
+        let lowest_land = sea - hills_max - overhang_amp;
+        let lowest_cave = sea + s.l_d - caves.reach_below();
+        let highest = sea + (LOWLAND_RISE + MOUNTAIN_HEIGHT) * t + hills_max + overhang_amp;
+        let margin = 1e-6 * t;
+        let bounds = (
+            lowest_floor.min(lowest_land).min(lowest_cave) - margin,
+            highest + margin,
+        );
+        EarthModel {
+            s,
+            sea,
+            continents: Fbm::new(derive_seed(seed, 10), FbmParams::new(CONTINENT_FREQ, cont_oct)),
+            belts: Fbm::new(derive_seed(seed, 11), FbmParams::new(BELT_FREQ, 2)),
+            hills: Fbm::new(derive_seed(seed, 12), FbmParams::new(1.0 / HILLS_WAVELENGTH, hills_oct)),
+            ridges: Ridged::new(
+                derive_seed(seed, 13),
+                RidgedParams::new(1.0 / RIDGE_WAVELENGTH, ridge_oct),
+            ),
+            region_seed: derive_seed(seed, 14),
+            region_freq: s.freq(CAVE_REGION * s.tile),
+            overhang: Overhang::new(
+                derive_seed(seed, 15),
+                OVERHANG_ACROSS * s.tile,
+                OVERHANG_DEEP * s.l_d,
+                sea,
+                s.l_d,
+            ),
+            overhang_amp,
+            caves,
+            bounds,
+        }
+    }
+
+    /// The sea radius.
+    pub(crate) fn sea(&self) -> f64 {
+        self.sea
+    }
+}
+
+impl ColumnModel for EarthModel {
+    type Column = EarthColumn;
+
+    fn column(&self, dir: DVec3) -> EarthColumn {
+        let t = self.s.thickness;
+        let e = self.continents.sample(dir) + CONTINENT_BIAS;
+        // Ocean floor (e < 0) and lowlands (e > 0); both are 0 with zero slope at the coast.
+        let ocean = -t * (SHELF_DEPTH * smoothstep(0.0, 0.025, -e) + OCEAN_DEPTH * smoothstep(0.02, 0.16, -e));
+        let land = t * LOWLAND_RISE * smoothstep(0.0, 0.25, e);
+        let hills_amp = t * lerp(HILLS_SEA, HILLS_LAND, smoothstep(-0.02, 0.05, e));
+        let hills = 2.0 * hills_amp * self.hills.sample(dir);
+        // Mountain belts along the zero set of a low-frequency noise, on land only. The belt and
+        // ridge noises are skipped where their factor is exactly zero.
+        let land_gate = smoothstep(0.015, 0.07, e);
+        let mountains = if land_gate > 0.0 {
+            (1.0 - smoothstep(0.02, 0.10, self.belts.sample(dir).abs())) * land_gate
+        } else {
+            0.0
+        };
+        let (peaks, steep) = if mountains > 0.0 {
+            let ridge = smoothstep(0.35, 0.95, self.ridges.sample(dir));
+            (t * MOUNTAIN_HEIGHT * mountains * ridge, smoothstep(0.2, 0.6, ridge))
+        } else {
+            (0.0, 0.0)
+        };
+        let h = self.sea + ocean + land + hills + peaks;
+        let amp = self.overhang_amp * mountains * steep;
+        // Caves: between sea level and a roof under the surface, in regions; where the region
+        // noise is high the roof goes above the surface, so tubes open as cave mouths.
+        let region = gradient3(dir * self.region_freq, self.region_seed);
+        let gate = smoothstep(-0.25, -0.05, region);
+        let mouth = smoothstep(0.15, 0.35, region);
+        let roof = self.s.l_d * (CAVE_ROOF - 5.0 * mouth);
+        let bottom = (self.sea + self.s.l_d).max(h - CAVE_BAND * t);
+        let band = self.caves.band(bottom, h - roof, gate);
+        EarthColumn {
+            h,
+            amp,
+            band,
+            mountains,
+        }
+    }
+
+    #[inline]
+    fn voxel(&self, col: &EarthColumn, dir: DVec3, _p: DVec3, r: f64) -> f64 {
+        let d0 = self.overhang.displace(col.h, col.amp, dir, r);
+        self.caves.carve(d0, &col.band, dir, r)
+    }
+
+    fn bounds(&self) -> (f64, f64) {
+        self.bounds
+    }
+}
+
+/// The earthlike shader: height bands (sea-floor sand, beach, grass and forest, rock, snow above
+/// a line that drops toward the poles), rock on steep slopes, cave rock under the surface, each
+/// material two colours mixed by noise.
+pub(crate) struct EarthShader {
+    model: Arc<EarthModel>,
+    palette: Palette,
+    jitter_seed: u64,
+    forest_seed: u64,
+}
+
+impl EarthShader {
+    fn new(model: Arc<EarthModel>, seed: u64) -> Self {
+        let tile = model.s.tile;
+        let palette = Palette::new(
+            derive_seed(seed, 30),
+            vec![
+                Material::srgb([222, 204, 150], [196, 176, 124]), // sand
+                Material::srgb([92, 138, 58], [124, 158, 70]),    // grass
+                Material::srgb([38, 84, 36], [58, 100, 44]),      // forest
+                Material::srgb([112, 106, 98], [146, 138, 126]),  // rock
+                Material::srgb([244, 246, 252], [218, 226, 240]), // snow
+                Material::srgb([62, 56, 52], [90, 80, 72]),       // cave
+            ],
+            1.5 * tile,
+        );
+        EarthShader {
+            model,
+            palette,
+            jitter_seed: derive_seed(seed, 31),
+            forest_seed: derive_seed(seed, 32),
+        }
+    }
+
+    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+        let m = &*self.model;
+        let (t, l_d, tile) = (m.s.thickness, m.s.l_d, m.s.tile);
+        let r = p.length();
+        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let col = m.column(dir);
+        if col.h - r > (1.5 * l_d).max(col.amp + l_d) {
+            return CAVE;
+        }
+        let up = normal.dot(dir);
+        let z = r - m.sea + 0.012 * t * gradient3(p / (2.0 * tile), self.jitter_seed);
+        let snow_line = t * (0.25 - 0.32 * dir.y * dir.y);
+        if z > snow_line.max(0.004 * t) && up > 0.5 {
+            SNOW
+        } else if up < 0.62 {
+            ROCK
+        } else if z < 0.012 * t {
+            SAND
+        } else if z < 0.10 * t {
+            if gradient3(dir * m.s.freq(8.0 * tile), self.forest_seed) > 0.05 {
+                FOREST
+            } else {
+                GRASS
+            }
+        } else if z < 0.18 * t && !(col.mountains > 0.6 && z > 0.13 * t) {
+            FOREST
+        } else {
+            ROCK
+        }
+    }
+}
+
+impl Shader for EarthShader {
+    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
+        self.palette.shade(self.material(p, normal), p)
+    }
+}
+
+/// Builds the earthlike terrain.
+pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
+    let model = Arc::new(EarthModel::new(seed, layout));
+    Terrain {
+        kind: PresetKind::Earthlike,
+        seed,
+        sea_radius: Some(model.sea()),
+        shader: Arc::new(EarthShader::new(model.clone(), seed)),
+        density: Arc::new(ColumnDensity(model)),
+        materials: MATERIALS,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::presets::testing::*;
+    use crate::Density;
+
+    fn terrain(seed: u64) -> (Terrain, Arc<EarthModel>) {
+        let layout = Layout::default();
+        (build(seed, &layout), Arc::new(EarthModel::new(seed, &layout)))
+    }
+
+    #[test]
+    fn land_and_sea() {
+        let (_, m) = terrain(1);
+        let dirs = sphere_dirs(4000);
+        let land = dirs.iter().filter(|d| m.column(**d).h > m.sea).count() as f64 / dirs.len() as f64;
+        assert!((0.2..0.6).contains(&land), "land fraction {land}");
+    }
+
+    #[test]
+    fn mountains_reach_their_height() {
+        let (_, m) = terrain(1);
+        let top = sphere_dirs(20_000)
+            .iter()
+            .map(|d| m.column(*d).h)
+            .fold(f64::MIN, f64::max);
+        let t = m.s.thickness;
+        assert!(
+            top - m.sea > 0.2 * t && top - m.sea < 0.4 * t,
+            "highest peak {} T",
+            (top - m.sea) / t
+        );
+        let deep = sphere_dirs(20_000)
+            .iter()
+            .map(|d| m.column(*d).h)
+            .fold(f64::MAX, f64::min);
+        assert!(
+            m.sea - deep > 0.15 * t && m.sea - deep < 0.3 * t,
+            "deepest sea {} T",
+            (m.sea - deep) / t
+        );
+    }
+
+    #[test]
+    fn has_caves_above_sea_level_only() {
+        let (ter, m) = terrain(1);
+        let mut cave_air = 0;
+        for d in sphere_dirs(3000) {
+            let col = m.column(d);
+            let mut r = m.sea - 3.0 * m.s.l_d;
+            while r < col.h - 3.0 * m.s.l_d - col.amp {
+                if ter.density.density(d * r) <= 0.0 {
+                    assert!(r > m.sea, "dry cave under the sea at {}", r - m.sea);
+                    cave_air += 1;
+                }
+                r += 1.0;
+            }
+        }
+        assert!(cave_air > 50, "found {cave_air} cave samples");
+    }
+
+    #[test]
+    fn has_overhangs_and_cave_mouths() {
+        let (ter, m) = terrain(1);
+        let (lo, hi) = ter.density.radial_bounds().unwrap();
+        let mut folds = 0;
+        let mut mouths = 0;
+        for d in sphere_dirs(6000) {
+            let col = m.column(d);
+            if sign_changes(&*ter.density, d, lo, hi, 0.5) > 1 {
+                folds += 1;
+            }
+            // A cave mouth: air 1.5 l_d under the height-field surface where nothing displaces
+            // it (the normal cave roof is thicker, so this is a tube breaking the surface).
+            if col.amp == 0.0
+                && col.h > m.sea + 3.0 * m.s.l_d
+                && ter.density.density(d * (col.h - 1.5 * m.s.l_d)) <= 0.0
+            {
+                mouths += 1;
+            }
+        }
+        assert!(folds > 20, "radial lines with more than one surface crossing: {folds}");
+        assert!(mouths > 3, "cave mouths: {mouths}");
+    }
+
+    #[test]
+    fn overhangs_fold_the_surface_in_the_mountains() {
+        let (ter, m) = terrain(1);
+        let (lo, hi) = ter.density.radial_bounds().unwrap();
+        let mut folded = 0;
+        for d in sphere_dirs(20_000) {
+            let col = m.column(d);
+            if col.amp > 0.0 {
+                // Look only within the overhang window, above any cave band.
+                let a = col.h - 1.6 * col.amp - m.s.l_d;
+                if sign_changes(&*ter.density, d, a.max(lo), hi, 0.25) > 1 && ter.density.density(d * a) > 0.0 {
+                    folded += 1;
+                }
+            }
+        }
+        assert!(folded > 5, "overhangs: {folded}");
+    }
+
+    #[test]
+    fn shader_tells_beach_from_snowy_peak() {
+        let (ter, m) = terrain(1);
+        let mut beach = None;
+        let mut peak = None;
+        for d in sphere_dirs(20_000) {
+            let col = m.column(d);
+            let z = col.h - m.sea;
+            let shade = ter.shader.shade(d * col.h, d);
+            if z > 0.0 && z < 0.004 * m.s.thickness && d.y.abs() < 0.5 && beach.is_none() {
+                beach = Some(shade);
+            }
+            if peak.is_none_or(|(best, _)| z > best) {
+                peak = Some((z, shade));
+            }
+        }
+        let beach = beach.expect("a beach");
+        let peak = peak.unwrap().1;
+        assert_eq!(MATERIALS[usize::from(beach.material)], "sand");
+        assert_eq!(MATERIALS[usize::from(peak.material)], "snow");
+        assert_ne!(beach.color, peak.color);
+        // A cliff is rock.
+        let d = sphere_dirs(10).remove(3);
+        let col = m.column(d);
+        let side = d.cross(DVec3::Z).normalize();
+        assert_eq!(ter.shader.shade(d * col.h, side).material, ROCK);
+    }
+
+    #[test]
+    fn batch_matches_points_and_is_deterministic() {
+        let (ter, m) = terrain(7);
+        check_batch_matches_points(&*ter.density, &land_patch(&m), 1e-3);
+    }
+
+    #[test]
+    fn surface_within_bounds() {
+        let (ter, _) = terrain(3);
+        check_surface_within_bounds(&ter, &Layout::default());
+    }
+
+    #[test]
+    fn seeds_differ() {
+        let (a, _) = terrain(1);
+        let (b, _) = terrain(2);
+        check_seeds_differ(&*a.density, &*b.density, &Layout::default());
+    }
+
+    #[test]
+    fn scales_follow_the_layout() {
+        // A planet four times larger in every length: the same seed gives the same relief in
+        // units of the shell, at about the same places.
+        let small = Layout::default();
+        let big = Layout::new(8, 32, 4.0 * 1744.0, 16.0, 2).unwrap();
+        let (ms, mb) = (EarthModel::new(5, &small), EarthModel::new(5, &big));
+        let mut close = 0;
+        let dirs = sphere_dirs(500);
+        for d in &dirs {
+            let zs = (ms.column(*d).h - ms.sea) / ms.s.thickness;
+            let zb = (mb.column(*d).h - mb.sea) / mb.s.thickness;
+            if (zs - zb).abs() < 1e-9 {
+                close += 1;
+            }
+        }
+        assert_eq!(close, dirs.len());
+        let (lo, hi) = ColumnDensity(Arc::new(mb)).radial_bounds().unwrap();
+        assert!(lo > big.d_b() && hi < big.radius());
+    }
+
+    /// A surface chunk's worth of directions around some land (used by the batch check).
+    fn land_patch(m: &EarthModel) -> (Vec<DVec3>, Vec<f64>) {
+        let d = sphere_dirs(4000)
+            .into_iter()
+            .find(|d| {
+                let c = m.column(*d);
+                c.mountains > 0.5 && c.amp > 0.0
+            })
+            .expect("a mountain");
+        patch(d, m.s.tile, 12, m.sea - 10.0 * m.s.l_d, m.s.l_d, 30)
+    }
+}

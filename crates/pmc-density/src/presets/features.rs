@@ -1,0 +1,346 @@
+//! Building blocks shared by the presets: layout scales, masks, the column/voxel split behind
+//! every preset's batch sampling, spaghetti caves and overhang displacement.
+//!
+//! # Exact skipping
+//!
+//! A preset's density is `min(D0, C)`: the displaced terrain `D0` carved by the cave field `C`.
+//! Both 3D noise terms are only evaluated where they can matter, and every shortcut returns the
+//! bits the full formula would give:
+//!
+//! - The overhang displacement is multiplied by a radial window that is exactly zero more than
+//!   `reach` from the column's surface, so there the formula is `(h - r) + 0 = h - r`.
+//! - The cave field has a lower bound that needs no noise, `-t S + P(r)`. Where that bound is at
+//!   least `D0`, `min(D0, C) = D0`.
+
+use crate::noise::{gradient3, gradient3_pair, octaves_for, DEFAULT_LACUNARITY};
+use crate::Density;
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::Layout;
+use std::sync::Arc;
+
+/// `smoothstep` from `e0` to `e1` (either order): 0 before `e0`, 1 after `e1`, C1 in between.
+/// Exactly 0 and exactly 1 outside the ramp, which the presets rely on to skip work.
+#[inline]
+pub(crate) fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Linear interpolation.
+#[inline]
+pub(crate) fn lerp(a: f64, b: f64, t: f64) -> f64 {
+    a + (b - a) * t
+}
+
+/// The scales of a layout that the presets express their features in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Scales {
+    /// Planet radius (the outermost voxel layer), metres.
+    pub radius: f64,
+    /// Radius of voxel layer 0 (`d_b`), metres.
+    pub base: f64,
+    /// Shell thickness `T = l_d n_t d_c`, metres: relief is expressed as fractions of it.
+    pub thickness: f64,
+    /// Voxel depth `l_d`, metres.
+    pub l_d: f64,
+    /// Horizontal tile size at the planet radius, `(pi / 2) R / (n_c n_t)`, metres.
+    pub tile: f64,
+}
+
+impl Scales {
+    /// The scales of `layout`.
+    pub fn new(layout: &Layout) -> Self {
+        let radius = layout.radius();
+        Scales {
+            radius,
+            base: layout.d_b(),
+            thickness: layout.l_d() * layout.depth_tiles() as f64,
+            l_d: layout.l_d(),
+            tile: std::f64::consts::FRAC_PI_2 * radius / layout.face_tiles() as f64,
+        }
+    }
+
+    /// The radius at fraction `f` of the shell (`d_b + f T`).
+    pub fn shell(&self, f: f64) -> f64 {
+        self.base + f * self.thickness
+    }
+
+    /// Noise frequency (lattice cells per unit of direction) for features of `wavelength` metres
+    /// at the planet surface.
+    pub fn freq(&self, wavelength: f64) -> f64 {
+        self.radius / wavelength
+    }
+
+    /// Octaves from features of `coarsest` metres down to about `finest` metres, at most `cap`.
+    pub fn octaves(&self, coarsest: f64, finest: f64, cap: u32) -> u32 {
+        octaves_for(coarsest, finest, DEFAULT_LACUNARITY).min(cap)
+    }
+}
+
+/// A density split into per-direction work (the column) and per-radius work (the voxel).
+pub(crate) trait ColumnModel: Send + Sync + 'static {
+    /// What a column computes once for all its radii.
+    type Column;
+    /// The column along unit direction `dir`.
+    fn column(&self, dir: DVec3) -> Self::Column;
+    /// The density at `p = dir * r` (with `r = |p|`) in that column.
+    fn voxel(&self, col: &Self::Column, dir: DVec3, p: DVec3, r: f64) -> f64;
+    /// Sound radial bounds (see [`Density::radial_bounds`]).
+    fn bounds(&self) -> (f64, f64);
+}
+
+/// A [`ColumnModel`] as a [`Density`]: the batch call evaluates each column once.
+///
+/// Point calls normalise `p` to find the column; the batch uses the given unit directions. Both
+/// use `r = |p|` with `p = dir * r` computed the same way, so they differ only by the rounding of
+/// the direction (a few `1e-16` relative), which the `f32` output almost always hides.
+pub(crate) struct ColumnDensity<M>(pub Arc<M>);
+
+impl<M: ColumnModel> Density for ColumnDensity<M> {
+    fn density(&self, p: DVec3) -> f64 {
+        let r = p.length();
+        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let col = self.0.column(dir);
+        self.0.voxel(&col, dir, p, r)
+    }
+
+    fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
+        let n = dirs.len();
+        for (d, dir) in dirs.iter().enumerate() {
+            let col = self.0.column(*dir);
+            for (k, r) in radii.iter().enumerate() {
+                let p = *dir * *r;
+                out[k * n + d] = self.0.voxel(&col, *dir, p, p.length()) as f32;
+            }
+        }
+    }
+
+    fn radial_bounds(&self) -> Option<(f64, f64)> {
+        Some(self.0.bounds())
+    }
+}
+
+/// Maps a point of a column to 3D noise coordinates with separate horizontal and vertical
+/// lengths: `dir * (r0 / lh + (r - r0) / lv)`. Horizontally the noise varies over `lh` metres
+/// (near `r0`), radially over `lv`, so features can be sized in tiles across and voxels deep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Stretch {
+    r0_h: f64,
+    r0: f64,
+    inv_v: f64,
+}
+
+impl Stretch {
+    /// Horizontal length `lh` and vertical length `lv` (metres), about reference radius `r0`.
+    pub fn new(lh: f64, lv: f64, r0: f64) -> Self {
+        Stretch {
+            r0_h: r0 / lh,
+            r0,
+            inv_v: 1.0 / lv,
+        }
+    }
+
+    /// Noise coordinates of radius `r` along `dir`.
+    #[inline]
+    pub fn at(&self, dir: DVec3, r: f64) -> DVec3 {
+        dir * (self.r0_h + (r - self.r0) * self.inv_v)
+    }
+}
+
+/// Mean gradient magnitude of [`gradient3`] per lattice unit (measured: 1.1), used to turn noise
+/// values into approximate metres.
+const MEAN_NOISE_GRADIENT: f64 = 1.1;
+
+/// Where caves may open in one column: the band `|r - mid| <= half`. Outside it the cave field
+/// rises by `slope` per metre, so tunnels end with a ceiling or floor within a few metres. A
+/// negative `half` closes the band; `-closed` closes it everywhere in the shell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CaveBand {
+    mid: f64,
+    half: f64,
+}
+
+/// Spaghetti caves: two 3D noise fields, air where both are near zero (the tubes along the
+/// intersection of their zero sets). The field is
+/// `C = (sqrt(n1^2 + n2^2) - t) S + slope max(0, |r - mid| - half)`, about metres from the tube
+/// wall (`S = lv / 1.1`).
+#[derive(Clone, Debug)]
+pub(crate) struct Spaghetti {
+    seed_a: u64,
+    seed_b: u64,
+    stretch: Stretch,
+    threshold: f64,
+    scale: f64,
+    neg_ts: f64,
+    slope: f64,
+    closed: f64,
+}
+
+impl Spaghetti {
+    /// Tubes whose noise varies over `lh` metres across and `lv` metres in depth, air where
+    /// `sqrt(n1^2 + n2^2) < threshold` (tube radius about `threshold lh / 1.1` across and
+    /// `threshold lv / 1.1` in depth, spacing about `lh`). `slope` closes the band;
+    /// `closed` is the band half-width used for "no caves here" (a shell thickness is plenty).
+    pub fn new(seeds: (u64, u64), lh: f64, lv: f64, r0: f64, threshold: f64, slope: f64, closed: f64) -> Self {
+        let scale = lv / MEAN_NOISE_GRADIENT;
+        Spaghetti {
+            seed_a: seeds.0,
+            seed_b: seeds.1,
+            stretch: Stretch::new(lh, lv, r0),
+            threshold,
+            scale,
+            neg_ts: -(threshold * scale),
+            slope,
+            closed,
+        }
+    }
+
+    /// The band from `bottom` to `top` (radii), opened by `gate` in `[0, 1]` (0 closes it
+    /// completely, continuously).
+    #[inline]
+    pub fn band(&self, bottom: f64, top: f64, gate: f64) -> CaveBand {
+        let half = 0.5 * (top - bottom);
+        CaveBand {
+            mid: 0.5 * (top + bottom),
+            half: gate * half - (1.0 - gate) * self.closed,
+        }
+    }
+
+    /// How far below a band's bottom a tube can still open air.
+    pub fn reach_below(&self) -> f64 {
+        self.threshold * self.scale / self.slope
+    }
+
+    /// `min(d0, C)` at radius `r` along `dir`, evaluating noise only where `C < d0` is possible.
+    #[inline]
+    pub fn carve(&self, d0: f64, band: &CaveBand, dir: DVec3, r: f64) -> f64 {
+        let pen = self.slope * ((r - band.mid).abs() - band.half).max(0.0);
+        // sqrt(..) >= 0, so C >= -t S + pen (the operations are monotone, also when rounded).
+        if self.neg_ts + pen >= d0 {
+            return d0;
+        }
+        let (n1, n2) = gradient3_pair(self.stretch.at(dir, r), self.seed_a, self.seed_b);
+        let c = ((n1 * n1 + n2 * n2).sqrt() - self.threshold) * self.scale + pen;
+        d0.min(c)
+    }
+
+    /// The full formula with no shortcuts (for tests).
+    #[cfg(test)]
+    pub fn carve_reference(&self, d0: f64, band: &CaveBand, dir: DVec3, r: f64) -> f64 {
+        let pen = self.slope * ((r - band.mid).abs() - band.half).max(0.0);
+        let q = self.stretch.at(dir, r);
+        let (n1, n2) = (gradient3(q, self.seed_a), gradient3(q, self.seed_b));
+        d0.min(((n1 * n1 + n2 * n2).sqrt() - self.threshold) * self.scale + pen)
+    }
+}
+
+/// Overhangs: a 3D noise displacement of the height field, `(h - r) + a w(|h - r|) n(p)`, with
+/// the window `w` equal to 1 within `a` of the column's surface and falling to exactly 0 at
+/// `a + falloff`. Where `a` is large compared with the noise's vertical length, the radial
+/// derivative of the displacement exceeds 1 and the surface folds over (overhangs, arches).
+///
+/// The surface itself always lies within `a` of `h` (the displacement is at most `a`), so the
+/// window never moves it; it only keeps the far field exactly `h - r`.
+#[derive(Clone, Debug)]
+pub(crate) struct Overhang {
+    seed: u64,
+    stretch: Stretch,
+    min_falloff: f64,
+}
+
+impl Overhang {
+    /// Displacement noise varying over `lh` metres across and `lv` in depth; the window falls
+    /// off over `a / 2 + min_falloff`.
+    pub fn new(seed: u64, lh: f64, lv: f64, r0: f64, min_falloff: f64) -> Self {
+        Overhang {
+            seed,
+            stretch: Stretch::new(lh, lv, r0),
+            min_falloff,
+        }
+    }
+
+    /// The displaced terrain at radius `r` of a column with surface `h` and amplitude `a >= 0`.
+    #[inline]
+    pub fn displace(&self, h: f64, a: f64, dir: DVec3, r: f64) -> f64 {
+        let base = h - r;
+        if a <= 0.0 {
+            return base;
+        }
+        let reach = a + (0.5 * a + self.min_falloff);
+        let z = base.abs();
+        if z >= reach {
+            // w = 1 - smoothstep(a, reach, z) = 0: the formula gives base + 0.
+            return base;
+        }
+        let w = 1.0 - smoothstep(a, reach, z);
+        base + a * w * gradient3(self.stretch.at(dir, r), self.seed)
+    }
+
+    /// The full formula with no shortcuts (for tests).
+    #[cfg(test)]
+    pub fn displace_reference(&self, h: f64, a: f64, dir: DVec3, r: f64) -> f64 {
+        let base = h - r;
+        let reach = a + (0.5 * a + self.min_falloff);
+        let w = 1.0 - smoothstep(a, reach, base.abs());
+        base + a * w * gradient3(self.stretch.at(dir, r), self.seed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smoothstep_is_exact_outside_the_ramp() {
+        assert_eq!(smoothstep(0.2, 0.4, 0.1), 0.0);
+        assert_eq!(smoothstep(0.2, 0.4, 0.5), 1.0);
+        assert_eq!(smoothstep(0.4, 0.2, 0.5), 0.0);
+        assert!((smoothstep(0.2, 0.4, 0.3) - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn scales_of_the_default_layout() {
+        let s = Scales::new(&Layout::default());
+        assert_eq!(s.thickness, 256.0);
+        assert_eq!(s.radius, 2000.0);
+        assert!((s.tile - 12.27).abs() < 0.01, "{}", s.tile);
+        assert_eq!(s.shell(0.5), 1744.0 + 128.0);
+    }
+
+    #[test]
+    fn cave_and_overhang_shortcuts_are_exact() {
+        let caves = Spaghetti::new((1, 2), 120.0, 50.0, 1900.0, 0.1, 8.0, 256.0);
+        let over = Overhang::new(3, 30.0, 16.0, 1900.0, 4.0);
+        let mut carved = 0;
+        for i in 0..4000 {
+            let t = i as f64 * 0.0123;
+            let dir = DVec3::new(t.cos(), (t * 0.37).sin(), t.sin() * 0.8).normalize();
+            let h = 1900.0 + 30.0 * (t * 3.1).sin();
+            let a = (12.0 * (t * 1.7).cos()).max(0.0);
+            let band = caves.band(1880.0, h - 5.0, smoothstep(-0.5, 0.5, (t * 0.9).sin()));
+            for k in 0..60 {
+                let r = 1850.0 + k as f64 * 2.0;
+                let d0 = over.displace(h, a, dir, r);
+                assert_eq!(d0.to_bits(), over.displace_reference(h, a, dir, r).to_bits());
+                let d = caves.carve(d0, &band, dir, r);
+                assert_eq!(d.to_bits(), caves.carve_reference(d0, &band, dir, r).to_bits());
+                if d < d0 {
+                    carved += 1;
+                }
+            }
+        }
+        assert!(carved > 100, "the test should exercise the carving path: {carved}");
+    }
+
+    #[test]
+    fn closed_band_never_carves() {
+        let caves = Spaghetti::new((1, 2), 120.0, 50.0, 1900.0, 0.1, 8.0, 256.0);
+        let band = caves.band(1880.0, 1950.0, 0.0);
+        for k in 0..200 {
+            let r = 1700.0 + k as f64;
+            let d0 = 1920.0 - r;
+            assert_eq!(caves.carve(d0, &band, DVec3::X, r), d0);
+        }
+    }
+}

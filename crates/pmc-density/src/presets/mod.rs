@@ -1,0 +1,219 @@
+//! Terrain presets: a density, a sea level and a shader, built for a layout and a seed.
+
+mod craters;
+mod earthlike;
+mod features;
+mod mars;
+mod moon;
+mod shading;
+mod sphere;
+#[cfg(test)]
+mod testing;
+
+use crate::Density;
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::Layout;
+use std::sync::Arc;
+
+/// The named presets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PresetKind {
+    /// An exact sphere (for checks): no relief, no sea.
+    Sphere,
+    /// Continents, seas, ridged mountains, caves and overhangs (the default).
+    Earthlike,
+    /// Grey, cratered, airless, with lava tubes.
+    Moon,
+    /// Red, dry, with canyons, volcanoes, dunes, polar caps and caves.
+    Mars,
+}
+
+impl PresetKind {
+    /// Every preset, in the order `--help` lists them.
+    pub const ALL: [PresetKind; 4] = [
+        PresetKind::Sphere,
+        PresetKind::Earthlike,
+        PresetKind::Moon,
+        PresetKind::Mars,
+    ];
+
+    /// The preset's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            PresetKind::Sphere => "sphere",
+            PresetKind::Earthlike => "earthlike",
+            PresetKind::Moon => "moon",
+            PresetKind::Mars => "mars",
+        }
+    }
+
+    /// One line describing the preset.
+    pub fn description(self) -> &'static str {
+        match self {
+            PresetKind::Sphere => "an exact sphere in the middle of the shell, for checks",
+            PresetKind::Earthlike => "continents, seas, ridged mountains, caves and overhangs",
+            PresetKind::Moon => "grey cratered highlands and maria, lava tubes, no sea",
+            PresetKind::Mars => "red deserts, canyons, volcanoes, polar caps and caves, no sea",
+        }
+    }
+}
+
+impl std::fmt::Display for PresetKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown preset name.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown preset '{0}' (choose one of: sphere, earthlike, moon, mars)")]
+pub struct UnknownPreset(pub String);
+
+impl std::str::FromStr for PresetKind {
+    type Err = UnknownPreset;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        PresetKind::ALL
+            .into_iter()
+            .find(|p| p.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| UnknownPreset(s.to_string()))
+    }
+}
+
+/// How a surface point looks: a colour and a material id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shade {
+    /// Linear RGBA colour (glTF `COLOR_0` space).
+    pub color: [u8; 4],
+    /// Material id, an index into [`Terrain::materials`].
+    pub material: u8,
+}
+
+/// Colours a surface point. Deterministic and thread-safe.
+pub trait Shader: Send + Sync {
+    /// The shade at world point `p` with unit outward normal `normal`.
+    fn shade(&self, p: DVec3, normal: DVec3) -> Shade;
+}
+
+/// A planet's terrain: density, sea and look, ready to mesh.
+#[derive(Clone)]
+pub struct Terrain {
+    /// The preset it was built from.
+    pub kind: PresetKind,
+    /// The seed it was built with.
+    pub seed: u64,
+    /// The density field (positive solid).
+    pub density: Arc<dyn Density>,
+    /// Radius of the sea surface, if the planet has a sea.
+    pub sea_radius: Option<f64>,
+    /// The shader.
+    pub shader: Arc<dyn Shader>,
+    /// Material names, indexed by [`Shade::material`].
+    pub materials: &'static [&'static str],
+}
+
+impl std::fmt::Debug for Terrain {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Terrain")
+            .field("kind", &self.kind)
+            .field("seed", &self.seed)
+            .field("sea_radius", &self.sea_radius)
+            .finish()
+    }
+}
+
+/// Builds the terrain of `kind` for `layout` and `seed`.
+///
+/// Scales follow the layout: relief is set in fractions of the shell thickness
+/// `T = l_d n_t d_c`, horizontal noise frequencies relative to the planet radius (3D noise on the
+/// unit sphere, seed 000 Sec. 4.6), caves and overhangs in voxel depths `l_d` and horizontal tile
+/// sizes `(pi / 2) R / (n_c n_t)`. The same kind, seed and layout give bit-identical terrain.
+pub fn build(kind: PresetKind, seed: u64, layout: &Layout) -> Terrain {
+    match kind {
+        PresetKind::Sphere => sphere::build(seed, layout),
+        PresetKind::Earthlike => earthlike::build(seed, layout),
+        PresetKind::Moon => moon::build(seed, layout),
+        PresetKind::Mars => mars::build(seed, layout),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse() {
+        assert_eq!("EarthLike".parse::<PresetKind>(), Ok(PresetKind::Earthlike));
+        assert_eq!(" moon ".parse::<PresetKind>(), Ok(PresetKind::Moon));
+        assert_eq!("venus".parse::<PresetKind>(), Err(UnknownPreset("venus".into())));
+        for k in PresetKind::ALL {
+            assert_eq!(k.to_string().parse::<PresetKind>(), Ok(k));
+        }
+    }
+
+    #[test]
+    fn every_preset_builds_deterministically_with_valid_shades() {
+        let layout = Layout::default();
+        let dirs = testing::sphere_dirs(300);
+        let radii: Vec<f64> = (0..=16).map(|k| layout.layer_radius(4 * k)).collect();
+        for kind in PresetKind::ALL {
+            let a = build(kind, 11, &layout);
+            let b = build(kind, 11, &layout);
+            assert_eq!((a.kind, a.seed), (kind, 11));
+            assert!(!a.materials.is_empty());
+            let mut va = vec![0.0f32; dirs.len() * radii.len()];
+            let mut vb = va.clone();
+            a.density.sample_shell(&dirs, &radii, &mut va);
+            b.density.sample_shell(&dirs, &radii, &mut vb);
+            assert!(
+                va.iter().zip(&vb).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{kind} is not deterministic"
+            );
+            for d in &dirs {
+                let p = *d * layout.d_b() * 1.1;
+                let s = a.shader.shade(p, *d);
+                assert_eq!(s, b.shader.shade(p, *d));
+                assert!(
+                    usize::from(s.material) < a.materials.len(),
+                    "{kind}: material {} out of range",
+                    s.material
+                );
+                assert_eq!(s.color[3], 255);
+            }
+            assert_eq!(a.sea_radius.is_some(), kind == PresetKind::Earthlike, "{kind}");
+        }
+    }
+
+    #[test]
+    fn presets_work_at_earth_radius() {
+        // 6.4e6 m radius, 2 m voxels: the noise must neither quantise nor repeat, and the relief
+        // still follows the shell.
+        let layout = Layout::new(4096, 32, 6.4e6, 2.0, 2).unwrap();
+        for kind in PresetKind::ALL {
+            let t = build(kind, 3, &layout);
+            testing::check_surface_within_bounds(&t, &layout);
+            if kind != PresetKind::Sphere {
+                let (lo, hi) = t.density.radial_bounds().unwrap();
+                let dirs = testing::sphere_dirs(400);
+                let heights: Vec<f64> = dirs
+                    .iter()
+                    .map(|d| {
+                        let mut r = hi;
+                        while r > lo && t.density.density(*d * r) <= 0.0 {
+                            r -= 0.5;
+                        }
+                        r
+                    })
+                    .collect();
+                let spread =
+                    heights.iter().cloned().fold(f64::MIN, f64::max) - heights.iter().cloned().fold(f64::MAX, f64::min);
+                assert!(spread > 0.1 * (hi - lo), "{kind}: relief {spread} m");
+                // Neighbouring voxel columns (2 m apart) give close but distinct values.
+                let d = dirs[7];
+                let e = (d + d.any_orthonormal_vector() * (2.0 / 6.4e6)).normalize();
+                let r = 0.5 * (lo + hi);
+                let (a, b) = (t.density.density(d * r), t.density.density(e * r));
+                assert!(a != b && (a - b).abs() < 5.0, "{kind}: {a} vs {b}");
+            }
+        }
+    }
+}
