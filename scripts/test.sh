@@ -21,7 +21,8 @@ step "cargo clippy (warnings denied)"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 
 step "cargo test"
-cargo test --workspace --locked
+mkdir -p target
+cargo test --workspace --locked 2>&1 | tee target/cargo-test.log
 
 step "build pmc (release)"
 cargo build --release --locked --bin pmc
@@ -46,3 +47,7 @@ python3 tools/check_mesh.py "$OUT/sphere.ply" --expect-euler 2 --expect-volume "
 python3 tools/check_mesh.py "$OUT/earthlike.ply"
 
 step "all checks passed"
+# One closing line: the Rust suite's totals plus the external checks above (the validator run
+# and the two trimesh checks; any failure there has already stopped the script).
+EXTERNAL_CHECKS=3
+awk -v ext="$EXTERNAL_CHECKS" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log

@@ -14,6 +14,17 @@ fn chunk(c: &mut Criterion) {
     g.bench_function(format!("earthlike/full/tris={}", out.triangle_count()), |b| {
         b.iter(|| planet.chunk_mesh_into(key, &mut scratch, &mut out))
     });
+    // The target pair: density (6-octave noise plus caves) plus meshing, no shading.
+    let grid = pmc_geometry::ChunkGrid::new(planet.layout(), key);
+    let mut d = vec![0.0f32; grid.sample_count()];
+    let mut mesher = pmc_mesh::Mesher::new();
+    g.bench_function(format!("earthlike/density+mesh/tris={}", out.triangle_count()), |b| {
+        b.iter(|| {
+            planet.terrain().density.sample_shell(&grid.dirs, &grid.radii, &mut d);
+            pmc_mesh::close_shell(&grid, planet.layout().depth_tiles(), &mut d);
+            mesher.mesh(&grid, &d, &mut out);
+        })
+    });
     g.finish();
 }
 

@@ -4,6 +4,7 @@ use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pmc_geometry::LatLon;
 use pmc_render::{Camera, RenderOptions};
 use std::path::PathBuf;
 
@@ -29,6 +30,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "METRES")]
     distance: Option<f64>,
 
+    /// Point the camera at this place on the surface, "LAT,LON" in degrees (default: the planet
+    /// centre). With --distance close to the radius this gives a view along the ground.
+    #[arg(long, value_name = "LAT,LON", value_parser = parse_lat_lon, allow_hyphen_values = true)]
+    look_at: Option<LatLon>,
+
     /// Image width in pixels.
     #[arg(long, default_value_t = 1280)]
     width: u32,
@@ -44,6 +50,18 @@ pub struct RenderArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
+}
+
+fn parse_lat_lon(s: &str) -> Result<LatLon, String> {
+    let (a, b) = s
+        .split_once(',')
+        .ok_or_else(|| format!("expected LAT,LON in degrees, got '{s}'"))?;
+    let num = |x: &str| {
+        x.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{}' is not a number of degrees", x.trim()))
+    };
+    LatLon::new(num(a)?, num(b)?).map_err(|e| e.to_string())
 }
 
 /// Runs `pmc render`.
@@ -76,14 +94,18 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let meshes = pool.install(|| planet.generate(|_| bar.inc(1)));
     bar.finish_and_clear();
     let radius = planet.layout().radius();
-    let camera = match args.distance {
+    let mut camera = match args.distance {
         Some(d) => Camera::orbit(args.lat, args.lon, d),
         None => Camera::framing(args.lat, args.lon, radius),
     };
+    if let Some(t) = args.look_at {
+        camera = camera.with_look_at(t.to_unit() * planet.datum_radius());
+    }
     let opts = RenderOptions {
         width: args.width,
         height: args.height,
         sea_radius: planet.terrain().sea_radius,
+        atmosphere: planet.terrain().sea_radius.is_some(),
         ..Default::default()
     };
     let image = pool.install(|| pmc_render::render(&meshes, &camera, &opts))?;

@@ -90,6 +90,25 @@ impl Mesher {
         } else {
             march_plain(&mut ctx, tables);
         }
+        finish_normals(out);
+    }
+}
+
+/// Normalises the gradient normals in one tight pass (it vectorises, unlike a square root and a
+/// division per vertex inside the march). A zero or non-finite gradient falls back to the
+/// radial direction.
+fn finish_normals(out: &mut ChunkMesh) {
+    for n in out.normals.iter_mut() {
+        let len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        let inv = 1.0 / len2.sqrt();
+        *n = [n[0] * inv, n[1] * inv, n[2] * inv];
+    }
+    let origin = out.origin;
+    for (n, p) in out.normals.iter_mut().zip(&out.positions) {
+        if !(n[0].is_finite() && n[1].is_finite() && n[2].is_finite()) {
+            let w = origin + DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+            *n = w.normalize_or(DVec3::Y).as_vec3().to_array();
+        }
     }
 }
 
@@ -267,16 +286,12 @@ impl Ctx<'_> {
         let gf = self.gradient(f);
         let gs = self.gradient(s);
         let grad = gf + (gs - gf) * t;
-        // Normalise in f32: the gradient's direction is all that is kept.
-        let normal = (-grad)
-            .as_vec3()
-            .try_normalize()
-            .unwrap_or_else(|| pos.normalize_or(DVec3::Y).as_vec3());
+        // Stored unnormalised; `finish_normals` normalises them all in one pass.
         let rel = pos - g.origin;
         let out = &mut *self.out;
         let idx = out.positions.len() as u32;
         out.positions.push(rel.as_vec3().to_array());
-        out.normals.push(normal.to_array());
+        out.normals.push((-grad).as_vec3().to_array());
         out.edge_keys
             .push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
         idx

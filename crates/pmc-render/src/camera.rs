@@ -11,8 +11,9 @@ pub const DEFAULT_FOV_DEG: f64 = 40.0;
 ///
 /// The world frame is the planet's (see [`pmc_geometry::LatLon`]): Y is the polar axis, longitude
 /// 0 is +Z and longitude +90 degrees is +X. The camera sits at `LatLon(lat, lon).to_unit() *
-/// distance` and looks at [`Camera::look_at`] (the planet centre when `None`). The image's "up" is
-/// +Y projected onto the image plane; when the camera looks straight along the polar axis it is
+/// distance` and looks at [`Camera::look_at`] (the planet centre when `None`). With a `look_at`
+/// target the image's "up" is the local vertical at the camera projected onto the image plane, so
+/// ground-level views keep the horizon level; otherwise it is +Y projected onto the image plane; when the camera looks straight along the polar axis it is
 /// the horizontal direction of `lon` (pointing away from the camera's side of the pole), which is
 /// the limit of the ordinary rule as `lat` goes to +-90 degrees.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,7 +108,16 @@ impl Camera {
             )));
         }
         let forward = to_target / reach;
-        let mut up = DVec3::Y - forward * forward.y;
+        // Looking at a place on the planet, "up" is the local vertical at the camera (the
+        // horizon stays level); looking at the centre, it is the polar axis.
+        let reference = match self.look_at {
+            Some(_) if eye.length() > 0.0 => eye.normalize(),
+            _ => DVec3::Y,
+        };
+        let mut up = reference - forward * forward.dot(reference);
+        if up.length() < 1e-9 {
+            up = DVec3::Y - forward * forward.y;
+        }
         if up.length() < 1e-9 {
             // Straight along the polar axis: the horizontal direction of the longitude, pointing
             // away from the camera's side (the limit of the projection of +Y).

@@ -59,6 +59,8 @@ pub struct RenderOptions {
     pub sea_radius: Option<f64>,
     /// sRGB colour of pixels where nothing is drawn.
     pub background: [u8; 3],
+    /// Whether to draw a thin atmosphere around the limb (for planets with air).
+    pub atmosphere: bool,
 }
 
 impl Default for RenderOptions {
@@ -72,6 +74,7 @@ impl Default for RenderOptions {
             sun_dir: DVec3::new(-1.0, 0.8, 1.2).normalize(),
             sea_radius: None,
             background: [5, 6, 12],
+            atmosphere: true,
         }
     }
 }

@@ -399,7 +399,7 @@ impl<'a> Shader<'a> {
         });
         // The atmosphere stands on the sea, or on the mean terrain radius when that is higher.
         let surface = mean_radius.max(opts.sea_radius.unwrap_or(0.0));
-        let atmosphere = (surface > 0.0 && count > 0).then(|| Atmosphere {
+        let atmosphere = (opts.atmosphere && surface > 0.0 && count > 0).then(|| Atmosphere {
             outer: surface * (1.0 + ATM_THICKNESS),
             hole: 0.9 * mean_radius,
             scale: 4.0 * ATM_THICKNESS * surface,
