@@ -2,8 +2,9 @@
 
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
+use crate::work;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 use pmc_formats::{ExportMeta, Format};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -30,59 +31,22 @@ pub struct GenerateArgs {
 
 /// Checks, before any work, that `path` can be written in a known format.
 fn check_output(path: &Path) -> Result<(), CliError> {
-    let err = |reason: String| CliError::Output {
+    Format::from_path(path).map_err(|e| CliError::Output {
         path: path.to_path_buf(),
-        reason,
-    };
-    Format::from_path(path).map_err(|e| err(e.to_string()))?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(err(format!(
-            "the directory {} does not exist; create it first",
-            dir.display()
-        )));
-    }
-    if path.is_dir() {
-        return Err(err("it is a directory; give a file name such as planet.glb".into()));
-    }
-    let probe = dir.join(format!(".pmc-write-check-{}", std::process::id()));
-    match std::fs::File::create(&probe) {
-        Ok(_) => {
-            let _ = std::fs::remove_file(&probe);
-            Ok(())
-        }
-        Err(e) => Err(err(format!("the directory {} is not writable ({e})", dir.display()))),
-    }
+        reason: e.to_string(),
+    })?;
+    work::check_writable(path)
 }
 
 /// Runs `pmc generate`.
 pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     let layout = args.planet.layout()?;
     check_output(&args.output)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| CliError::Threads {
-            threads: args.threads,
-            reason: e.to_string(),
-        })?;
+    let pool = work::thread_pool(args.threads)?;
     let start = Instant::now();
     let planet = pmc_planet::Planet::new(args.planet.preset, args.planet.seed, layout);
     let total = layout.chunk_count();
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} meshing chunks {bar:40} {pos}/{len} ({elapsed}, eta {eta})")
-            .expect("valid template"),
-    );
-    let meshes = pool.install(|| planet.generate(|_| bar.inc(1)));
-    bar.finish_and_clear();
+    let meshes = work::mesh_planet(&planet, &pool, args.quiet);
     let meshed = start.elapsed();
     let t = planet.terrain();
     let meta = ExportMeta {

@@ -6,6 +6,7 @@ mod generate;
 mod info;
 mod planet_args;
 mod render;
+mod work;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

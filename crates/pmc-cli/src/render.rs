@@ -2,8 +2,8 @@
 
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
+use crate::work;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pmc_geometry::LatLon;
 use pmc_render::{Camera, RenderOptions};
 use std::path::PathBuf;
@@ -74,25 +74,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             reason: "pictures are written as PNG: use a .png name".into(),
         });
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| CliError::Threads {
-            threads: args.threads,
-            reason: e.to_string(),
-        })?;
-    let total = planet.layout().chunk_count();
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} meshing chunks {bar:40} {pos}/{len} ({elapsed})")
-            .expect("valid template"),
-    );
-    let meshes = pool.install(|| planet.generate(|_| bar.inc(1)));
-    bar.finish_and_clear();
+    work::check_writable(&args.output)?;
+    let pool = work::thread_pool(args.threads)?;
+    let meshes = work::mesh_planet(&planet, &pool, args.quiet);
     let radius = planet.layout().radius();
     let mut camera = match args.distance {
         Some(d) => Camera::orbit(args.lat, args.lon, d),

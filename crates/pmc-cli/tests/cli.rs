@@ -144,3 +144,24 @@ fn help_explains_every_option() {
     }
     assert!(s.contains("earthlike") && s.contains("moon") && s.contains("mars"));
 }
+
+#[test]
+fn render_writes_a_png_and_refuses_bad_views() {
+    let p = tmp("planet.png");
+    let mut args = vec!["render", "--quiet", "--width", "160", "--height", "100", "-o", p.to_str().unwrap()];
+    args.extend(SMALL);
+    let o = pmc(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&p).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let mut ground = vec!["render", "--quiet", "--width", "64", "--height", "40", "--distance", "230", "--look-at=10,20"];
+    ground.push("-o");
+    ground.push(p.to_str().unwrap());
+    ground.extend(SMALL);
+    assert!(pmc(&ground).status.success());
+    assert_refused(&["render", "-o", "planet.jpg"], "PNG");
+    assert_refused(&["render", "--look-at=100,0", "-o", "x.png"], "latitude");
+    assert_refused(&["render", "--look-at", "abc", "-o", "x.png"], "LAT,LON");
+    assert_refused(&["render", "--width", "0", "-o", p.to_str().unwrap(), "--n-c", "1", "--n-t", "4"], "0");
+    assert_refused(&["render", "--distance", "NaN", "-o", p.to_str().unwrap(), "--n-c", "1", "--n-t", "4"], "NaN");
+}

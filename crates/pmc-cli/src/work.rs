@@ -1,0 +1,64 @@
+//! What several commands share: output checks, the thread pool, meshing with a progress bar.
+
+use crate::error::CliError;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pmc_mesh::ChunkMesh;
+use pmc_planet::Planet;
+use std::path::{Path, PathBuf};
+
+/// Checks, before any work, that a file can be created at `path`.
+pub fn check_writable(path: &Path) -> Result<(), CliError> {
+    let err = |reason: String| CliError::Output {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(err(format!(
+            "the directory {} does not exist; create it first",
+            dir.display()
+        )));
+    }
+    if path.is_dir() {
+        return Err(err("it is a directory; give a file name".into()));
+    }
+    let probe = dir.join(format!(".pmc-write-check-{}", std::process::id()));
+    match std::fs::File::create(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(err(format!("the directory {} is not writable ({e})", dir.display()))),
+    }
+}
+
+/// A rayon pool of `threads` workers (0: one per core).
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, CliError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CliError::Threads {
+            threads,
+            reason: e.to_string(),
+        })
+}
+
+/// Meshes every chunk of `planet` on `pool`, with a progress bar on stderr unless `quiet`.
+pub fn mesh_planet(planet: &Planet, pool: &rayon::ThreadPool, quiet: bool) -> Vec<ChunkMesh> {
+    let total = planet.layout().chunk_count();
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} meshing chunks {bar:40} {pos}/{len} ({elapsed}, eta {eta})")
+            .expect("valid template"),
+    );
+    let meshes = pool.install(|| planet.generate(|_| bar.inc(1)));
+    bar.finish_and_clear();
+    meshes
+}
