@@ -9,6 +9,18 @@ pub enum CliError {
     /// Invalid layout parameters.
     #[error("invalid planet layout: {0}")]
     Layout(#[from] pmc_geometry::LayoutError),
+    /// The planet is too large to mesh whole in memory.
+    #[error(
+        "the planet is too large to mesh whole: {face_tiles} tiles per face side and {chunks} chunks (at most {} and {}); lower n_c, n_t or d_c",
+        crate::work::MAX_WHOLE_PLANET_FACE_TILES,
+        crate::work::MAX_WHOLE_PLANET_CHUNKS
+    )]
+    TooLarge {
+        /// `n_c n_t`.
+        face_tiles: i64,
+        /// Eq. (2).
+        chunks: u64,
+    },
     /// The output path cannot be written.
     #[error("cannot write {path}: {reason}")]
     Output {
@@ -37,7 +49,7 @@ impl CliError {
     /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Layout(_) | CliError::Output { .. } => 2,
+            CliError::Layout(_) | CliError::Output { .. } | CliError::TooLarge { .. } => 2,
             CliError::Render(pmc_render::RenderError::Io { .. } | pmc_render::RenderError::Png { .. }) => 1,
             CliError::Render(_) => 2,
             CliError::Export(_) | CliError::Threads { .. } => 1,

@@ -41,6 +41,7 @@ fn check_output(path: &Path) -> Result<(), CliError> {
 /// Runs `pmc generate`.
 pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     let layout = args.planet.layout()?;
+    work::check_whole_planet(&layout)?;
     check_output(&args.output)?;
     let pool = work::thread_pool(args.threads)?;
     let start = Instant::now();

@@ -23,7 +23,9 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     let face_arc = std::f64::consts::FRAC_PI_2 * l.radius();
     let tile = face_arc / l.face_tiles() as f64;
     let bounds = t.density.radial_bounds();
-    let candidate = l.chunks(0).iter().filter(|k| planet.may_hold_surface(k)).count();
+    // Counting chunks one by one is only worth it for planets that can be meshed whole.
+    let candidate = (l.chunk_count() <= crate::work::MAX_WHOLE_PLANET_CHUNKS)
+        .then(|| l.chunks(0).iter().filter(|k| planet.may_hold_surface(k)).count());
     if args.json {
         let v = serde_json::json!({
             "preset": t.kind.name(),
@@ -77,10 +79,13 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         None => println!("sea          none"),
     }
     if let Some((a, b)) = bounds {
-        println!(
-            "surface      between radius {a:.2} and {b:.2} m; {candidate} of {} chunks may hold it",
-            l.chunk_count()
-        );
+        match candidate {
+            Some(c) => println!(
+                "surface      between radius {a:.2} and {b:.2} m; {c} of {} chunks may hold it",
+                l.chunk_count()
+            ),
+            None => println!("surface      between radius {a:.2} and {b:.2} m"),
+        }
     }
     println!("materials    {}", t.materials.join(", "));
     Ok(())

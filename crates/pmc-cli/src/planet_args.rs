@@ -21,7 +21,7 @@ pub struct PlanetArgs {
     #[arg(long = "n-c", default_value_t = 8, value_name = "N")]
     pub n_c: u32,
 
-    /// n_t: tiles (marching cubes) along each side of a chunk, 1..=256.
+    /// n_t: tiles (marching cubes) along each side of a chunk, 1..=128.
     #[arg(long = "n-t", default_value_t = 32, value_name = "N")]
     pub n_t: u32,
 

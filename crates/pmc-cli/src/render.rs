@@ -74,6 +74,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             reason: "pictures are written as PNG: use a .png name".into(),
         });
     }
+    work::check_whole_planet(planet.layout())?;
     work::check_writable(&args.output)?;
     let pool = work::thread_pool(args.threads)?;
     let meshes = work::mesh_planet(&planet, &pool, args.quiet);

@@ -35,6 +35,23 @@ pub fn check_writable(path: &Path) -> Result<(), CliError> {
     }
 }
 
+/// Most tiles along a face side for commands that mesh the whole planet at once: about 50
+/// million triangles and a few GB of meshes. Larger planets need streaming, not one file.
+pub const MAX_WHOLE_PLANET_FACE_TILES: i64 = 2048;
+/// Most chunks for commands that mesh the whole planet at once.
+pub const MAX_WHOLE_PLANET_CHUNKS: u64 = 200_000;
+
+/// Refuses layouts too large to mesh whole in memory, before any work.
+pub fn check_whole_planet(layout: &pmc_geometry::Layout) -> Result<(), CliError> {
+    if layout.face_tiles() > MAX_WHOLE_PLANET_FACE_TILES || layout.chunk_count() > MAX_WHOLE_PLANET_CHUNKS {
+        return Err(CliError::TooLarge {
+            face_tiles: layout.face_tiles(),
+            chunks: layout.chunk_count(),
+        });
+    }
+    Ok(())
+}
+
 /// A rayon pool of `threads` workers (0: one per core).
 pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, CliError> {
     rayon::ThreadPoolBuilder::new()

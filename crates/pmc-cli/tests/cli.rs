@@ -111,6 +111,13 @@ fn invalid_parameters_are_refused_clearly() {
     assert_refused(&["generate", "--seed", "-3"], "-3");
     assert_refused(&["generate", "--seed", "x"], "--seed");
     assert_refused(&["info", "--n-t", "100000"], "n_t");
+    assert_refused(&["info", "--n-t", "129"], "n_t");
+    // Valid layouts too large to mesh whole are refused before any work, never by running out
+    // of memory.
+    assert_refused(&["generate", "--n-c", "100000"], "too large");
+    assert_refused(&["render", "--n-c", "64", "--n-t", "64"], "too large");
+    let o = pmc(&["info", "--n-c", "100000"]);
+    assert!(o.status.success(), "info describes any valid layout: {}", stderr(&o));
 }
 
 #[test]
@@ -148,13 +155,32 @@ fn help_explains_every_option() {
 #[test]
 fn render_writes_a_png_and_refuses_bad_views() {
     let p = tmp("planet.png");
-    let mut args = vec!["render", "--quiet", "--width", "160", "--height", "100", "-o", p.to_str().unwrap()];
+    let mut args = vec![
+        "render",
+        "--quiet",
+        "--width",
+        "160",
+        "--height",
+        "100",
+        "-o",
+        p.to_str().unwrap(),
+    ];
     args.extend(SMALL);
     let o = pmc(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(&p).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
-    let mut ground = vec!["render", "--quiet", "--width", "64", "--height", "40", "--distance", "230", "--look-at=10,20"];
+    let mut ground = vec![
+        "render",
+        "--quiet",
+        "--width",
+        "64",
+        "--height",
+        "40",
+        "--distance",
+        "230",
+        "--look-at=10,20",
+    ];
     ground.push("-o");
     ground.push(p.to_str().unwrap());
     ground.extend(SMALL);
@@ -162,6 +188,32 @@ fn render_writes_a_png_and_refuses_bad_views() {
     assert_refused(&["render", "-o", "planet.jpg"], "PNG");
     assert_refused(&["render", "--look-at=100,0", "-o", "x.png"], "latitude");
     assert_refused(&["render", "--look-at", "abc", "-o", "x.png"], "LAT,LON");
-    assert_refused(&["render", "--width", "0", "-o", p.to_str().unwrap(), "--n-c", "1", "--n-t", "4"], "0");
-    assert_refused(&["render", "--distance", "NaN", "-o", p.to_str().unwrap(), "--n-c", "1", "--n-t", "4"], "NaN");
+    assert_refused(
+        &[
+            "render",
+            "--width",
+            "0",
+            "-o",
+            p.to_str().unwrap(),
+            "--n-c",
+            "1",
+            "--n-t",
+            "4",
+        ],
+        "0",
+    );
+    assert_refused(
+        &[
+            "render",
+            "--distance",
+            "NaN",
+            "-o",
+            p.to_str().unwrap(),
+            "--n-c",
+            "1",
+            "--n-t",
+            "4",
+        ],
+        "NaN",
+    );
 }

@@ -9,7 +9,7 @@ use glam::{DVec3, IVec3};
 /// Largest number of tiles along a face edge or the depth axis (keeps lattice keys in 32 bits).
 pub const MAX_AXIS_TILES: u64 = 1 << 24;
 /// Largest number of tiles per chunk axis (`n_t`): bounds the memory of one chunk.
-pub const MAX_CHUNK_TILES: u32 = 256;
+pub const MAX_CHUNK_TILES: u32 = 128;
 
 /// Why a set of layout parameters was refused. Each variant says which parameter to change.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -17,7 +17,7 @@ pub enum LayoutError {
     /// `n_c` must be at least 1: a face needs at least one chunk per side.
     #[error("n_c (chunks per face side) must be at least 1, got {0}")]
     ChunksPerSide(u32),
-    /// `n_t` must be in `1..=256`.
+    /// `n_t` must be in `1..=128`.
     #[error("n_t (tiles per chunk side) must be between 1 and {MAX_CHUNK_TILES}, got {0}")]
     TilesPerChunk(u32),
     /// `d_c` must be at least 1.
@@ -305,7 +305,7 @@ mod tests {
             Err(LayoutError::BaseDepth { .. })
         ));
         assert!(matches!(
-            Layout::new(1 << 20, 256, 10.0, 1.0, 1),
+            Layout::new(1 << 20, 128, 10.0, 1.0, 1),
             Err(LayoutError::TooLarge(_))
         ));
     }

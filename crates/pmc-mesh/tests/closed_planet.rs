@@ -104,3 +104,36 @@ proptest! {
         check_closed(&w);
     }
 }
+
+/// Degenerate iso values: samples exactly on the surface (density 0) count as air, so vertices may
+/// land exactly on voxels and triangles may have zero area, yet the surface stays a closed
+/// manifold and no vertex is lost or duplicated.
+#[test]
+fn exact_zero_samples_keep_the_surface_closed() {
+    let layout = Layout::new(2, 8, 40.0, 1.0, 2).unwrap();
+    // Integer-valued density: every voxel whose layer radius rounds to 48 sits exactly on it.
+    let f = FnDensity(|p: DVec3| (48.0 - p.length() + 1.5 * (p.x * 0.3).sin()).round());
+    let mut zeros = 0;
+    for key in layout.chunks(0) {
+        let grid = ChunkGrid::new(&layout, key);
+        let mut d = vec![0.0f32; grid.sample_count()];
+        f.sample_shell(&grid.dirs, &grid.radii, &mut d);
+        zeros += d.iter().filter(|v| **v == 0.0).count();
+    }
+    assert!(zeros > 1000, "the field has exact zeros: {zeros}");
+    let meshes = mesh_planet(&layout, &f);
+    let w = WeldedMesh::weld(&meshes);
+    check_closed(&w);
+    for m in &meshes {
+        assert!(m.normals.iter().all(|n| n.iter().all(|c| c.is_finite())), "finite normals");
+        assert!(m.positions.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    }
+}
+
+#[test]
+fn nan_samples_become_air_and_the_surface_stays_closed() {
+    let layout = Layout::new(1, 8, 40.0, 1.0, 2).unwrap();
+    let f = FnDensity(|p: DVec3| if (p.x * 0.7).sin() > 0.9 { f64::NAN } else { 48.3 - p.length() });
+    let w = WeldedMesh::weld(&mesh_planet(&layout, &f));
+    check_closed(&w);
+}
