@@ -125,7 +125,10 @@ fn exact_zero_samples_keep_the_surface_closed() {
     let w = WeldedMesh::weld(&meshes);
     check_closed(&w);
     for m in &meshes {
-        assert!(m.normals.iter().all(|n| n.iter().all(|c| c.is_finite())), "finite normals");
+        assert!(
+            m.normals.iter().all(|n| n.iter().all(|c| c.is_finite())),
+            "finite normals"
+        );
         assert!(m.positions.iter().all(|p| p.iter().all(|c| c.is_finite())));
     }
 }
@@ -133,7 +136,13 @@ fn exact_zero_samples_keep_the_surface_closed() {
 #[test]
 fn nan_samples_become_air_and_the_surface_stays_closed() {
     let layout = Layout::new(1, 8, 40.0, 1.0, 2).unwrap();
-    let f = FnDensity(|p: DVec3| if (p.x * 0.7).sin() > 0.9 { f64::NAN } else { 48.3 - p.length() });
+    let f = FnDensity(|p: DVec3| {
+        if (p.x * 0.7).sin() > 0.9 {
+            f64::NAN
+        } else {
+            48.3 - p.length()
+        }
+    });
     let w = WeldedMesh::weld(&mesh_planet(&layout, &f));
     check_closed(&w);
 }
