@@ -298,6 +298,7 @@ pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
         shader: Arc::new(EarthShader::new(model.clone(), seed)),
         density: Arc::new(ColumnDensity(model)),
         materials: MATERIALS,
+        blend_colors: [[0.42, 0.50, 0.26], [0.56, 0.47, 0.32]],
     }
 }
 

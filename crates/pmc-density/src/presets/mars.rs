@@ -311,6 +311,7 @@ pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
         shader: Arc::new(MarsShader::new(model.clone(), seed)),
         density: Arc::new(ColumnDensity(model)),
         materials: MATERIALS,
+        blend_colors: [[0.62, 0.27, 0.12], [0.44, 0.20, 0.13]],
     }
 }
 

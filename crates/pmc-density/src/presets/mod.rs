@@ -109,6 +109,9 @@ pub struct Terrain {
     pub shader: Arc<dyn Shader>,
     /// Material names, indexed by [`Shade::material`].
     pub materials: &'static [&'static str],
+    /// The planet's two blend colours (linear RGB, 0..1): renderers mix them by a noise value
+    /// over the terrain for large-scale variety (Fisher et al., seed 003 Sec. 7).
+    pub blend_colors: [[f32; 3]; 2],
 }
 
 impl std::fmt::Debug for Terrain {

@@ -215,6 +215,7 @@ pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
         shader: Arc::new(MoonShader::new(model.clone(), seed)),
         density: Arc::new(ColumnDensity(model)),
         materials: MATERIALS,
+        blend_colors: [[0.52, 0.52, 0.52], [0.36, 0.36, 0.40]],
     }
 }
 

@@ -38,6 +38,7 @@ pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
         sea_radius: None,
         shader: Arc::new(Grey(Material::srgb([150, 150, 146], [150, 150, 146]).color(0.0))),
         materials: MATERIALS,
+        blend_colors: [[0.60, 0.60, 0.60], [0.48, 0.50, 0.56]],
     }
 }
 
