@@ -14,6 +14,20 @@ if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 fi
 
+step "install the viewer's packages, and Chromium for its end-to-end tests"
+if [ ! -d viewer/node_modules ]; then
+  (cd viewer && npm ci --no-audit --no-fund --loglevel=error)
+fi
+if ! command -v chromium >/dev/null 2>&1; then
+  if [ "$(id -u)" = 0 ]; then
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium
+  else
+    echo "the end-to-end tests need Debian's chromium: sudo apt-get install chromium" >&2
+    exit 1
+  fi
+fi
+
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
@@ -23,6 +37,12 @@ cargo clippy --workspace --all-targets --locked -- -D warnings
 step "cargo test"
 mkdir -p target
 cargo test --workspace --locked 2>&1 | tee target/cargo-test.log
+
+step "viewer: type check and unit tests (vitest)"
+(cd viewer && npx tsc --noEmit && npm test 2>&1) | tee target/vitest.log
+
+step "viewer: build (embedded into pmc)"
+(cd viewer && npm run --silent build)
 
 step "build pmc (release)"
 cargo build --release --locked --bin pmc
@@ -46,8 +66,13 @@ V=$(python3 -c "import math; print(4/3*math.pi*$R**3)")
 python3 tools/check_mesh.py "$OUT/sphere.ply" --expect-euler 2 --expect-volume "$V" --tolerance 0.005
 python3 tools/check_mesh.py "$OUT/earthlike.ply"
 
+step "viewer: end-to-end tests in headless Chromium against pmc serve"
+(cd viewer && PMC_BIN="$PWD/../$PMC" node e2e/run.mjs 2>&1) | tee target/e2e.log
+
 step "all checks passed"
 # One closing line: the Rust suite's totals plus the external checks above (the validator run
 # and the two trimesh checks; any failure there has already stopped the script).
 EXTERNAL_CHECKS=3
-awk -v ext="$EXTERNAL_CHECKS" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log
+VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
+E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
+awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log

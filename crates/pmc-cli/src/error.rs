@@ -35,6 +35,12 @@ pub enum CliError {
     /// Rendering failed (bad camera or options, or the PNG could not be written).
     #[error(transparent)]
     Render(#[from] pmc_render::RenderError),
+    /// `--host` is neither an IP address nor "localhost".
+    #[error("--host '{0}' is not an IP address; use 127.0.0.1 (this machine only), 0.0.0.0 (every interface), ::1 or localhost")]
+    Host(String),
+    /// The server could not start (port in use, address not available, ...) or failed.
+    #[error(transparent)]
+    Serve(#[from] pmc_server::ServerError),
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads: {reason}")]
     Threads {
@@ -49,7 +55,9 @@ impl CliError {
     /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Layout(_) | CliError::Output { .. } | CliError::TooLarge { .. } => 2,
+            CliError::Layout(_) | CliError::Output { .. } | CliError::TooLarge { .. } | CliError::Host(_) => 2,
+            CliError::Serve(pmc_server::ServerError::Config(_)) => 2,
+            CliError::Serve(_) => 1,
             CliError::Render(pmc_render::RenderError::Io { .. } | pmc_render::RenderError::Png { .. }) => 1,
             CliError::Render(_) => 2,
             CliError::Export(_) | CliError::Threads { .. } => 1,

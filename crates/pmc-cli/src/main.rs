@@ -6,6 +6,7 @@ mod generate;
 mod info;
 mod planet_args;
 mod render;
+mod serve;
 mod work;
 
 use clap::{Parser, Subcommand};
@@ -27,6 +28,8 @@ enum Command {
     Info(info::InfoArgs),
     /// Render a picture of a planet to a PNG file.
     Render(render::RenderArgs),
+    /// Serve the web viewer and the HTTP API: chunks are generated on demand and streamed.
+    Serve(serve::ServeArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +38,7 @@ fn main() -> ExitCode {
         Command::Generate(a) => generate::run(a),
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
+        Command::Serve(a) => serve::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

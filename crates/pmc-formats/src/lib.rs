@@ -33,6 +33,7 @@
 #![warn(missing_docs)]
 
 mod check;
+pub mod chunk_encoding;
 mod error;
 mod export;
 mod format;

@@ -1,0 +1,103 @@
+//! `pmc serve`: the web viewer and the HTTP API, streaming chunks of a planet generated on demand.
+
+use crate::error::CliError;
+use crate::planet_args::PlanetArgs;
+use clap::Args;
+use pmc_server::{Server, ServerConfig};
+use std::io::{IsTerminal, Write};
+use std::net::{IpAddr, Ipv4Addr};
+
+/// Options of `pmc serve`.
+#[derive(Args, Debug)]
+pub struct ServeArgs {
+    #[command(flatten)]
+    planet: PlanetArgs,
+
+    /// Address to listen on: an IP address, or "localhost". 127.0.0.1 serves this machine only;
+    /// 0.0.0.0 serves every network interface.
+    #[arg(long, default_value = "127.0.0.1", value_name = "ADDRESS")]
+    host: String,
+
+    /// Port to listen on; 0 picks a free one (the URL line says which).
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+
+    /// Worker threads that generate chunks; 0 uses every core.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    threads: usize,
+
+    /// Most megabytes (MiB) of encoded chunks kept in memory.
+    #[arg(long = "cache-mb", default_value_t = 512, value_name = "MIB")]
+    cache_mb: u64,
+}
+
+/// Parses `--host`: an IP address or "localhost" (no name lookups).
+fn parse_host(s: &str) -> Result<IpAddr, CliError> {
+    if s.eq_ignore_ascii_case("localhost") {
+        return Ok(IpAddr::V4(Ipv4Addr::LOCALHOST));
+    }
+    s.trim_start_matches('[')
+        .trim_end_matches(']')
+        .parse::<IpAddr>()
+        .map_err(|_| CliError::Host(s.to_string()))
+}
+
+/// Runs `pmc serve` until Ctrl-C or SIGTERM.
+pub fn run(args: &ServeArgs) -> Result<(), CliError> {
+    let layout = args.planet.layout()?;
+    let host = parse_host(&args.host)?;
+    let config = ServerConfig {
+        host,
+        port: args.port,
+        preset: args.planet.preset,
+        seed: args.planet.seed,
+        layout,
+        cache_bytes: args.cache_mb.saturating_mul(1 << 20),
+        threads: args.threads,
+        ..ServerConfig::default()
+    };
+    init_logging();
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .thread_name("pmc-http")
+        .build()
+        .map_err(|e| CliError::Threads {
+            threads: 0,
+            reason: e.to_string(),
+        })?;
+    runtime.block_on(async {
+        let server = Server::bind(config).await?;
+        let mut out = std::io::stdout().lock();
+        // The URL line is what scripts and tests wait for; a closed stdout is no reason to stop.
+        let _ = writeln!(out, "PMC viewer: {}", server.url());
+        let _ = out.flush();
+        drop(out);
+        server.run(pmc_server::shutdown_signal()).await
+    })?;
+    Ok(())
+}
+
+/// Logs to stderr, filtered by `RUST_LOG` (default: the server's start and stop lines and
+/// warnings; `RUST_LOG=pmc_server=debug` adds one line per request).
+fn init_logging() {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,pmc_server=info"));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
+        .try_init();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hosts() {
+        assert_eq!(parse_host("localhost").unwrap(), IpAddr::V4(Ipv4Addr::LOCALHOST));
+        assert_eq!(parse_host("0.0.0.0").unwrap(), IpAddr::V4(Ipv4Addr::UNSPECIFIED));
+        assert!(parse_host("[::1]").unwrap().is_loopback());
+        assert!(matches!(parse_host("not-an-ip"), Err(CliError::Host(_))));
+    }
+}

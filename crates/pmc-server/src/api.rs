@@ -1,0 +1,344 @@
+//! The `/api/v1` endpoints (`docs/specs/http-api-v1.md`).
+
+use crate::bounds::{chunks_near, TooManyChunks};
+use crate::generator::{ChunkError, ChunkId, PlanetId};
+use crate::AppState;
+use axum::extract::rejection::PathRejection;
+use axum::extract::{Path, RawQuery, State};
+use axum::http::{header, HeaderValue, StatusCode, Uri};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use pmc_density::Density;
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::{ChunkKey, Face};
+use pmc_planet::PresetKind;
+use serde_json::{json, Value};
+
+/// Default and largest `limit` of `/chunks`.
+pub const DEFAULT_LIMIT: usize = 512;
+/// Largest `limit` of `/chunks`.
+pub const MAX_LIMIT: usize = 4096;
+/// Most chunks one `/chunks` query may test (after the quadtree has skipped the far ones).
+pub const MAX_TESTED_CHUNKS: usize = 200_000;
+
+/// An error answer: a status and a JSON `{"error": ...}` body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ApiError {
+    /// The HTTP status.
+    pub status: StatusCode,
+    /// What is wrong and how to fix it.
+    pub message: String,
+}
+
+impl ApiError {
+    /// A 400 Bad Request.
+    pub fn bad_request(message: impl Into<String>) -> ApiError {
+        ApiError {
+            status: StatusCode::BAD_REQUEST,
+            message: message.into(),
+        }
+    }
+
+    /// A 404 Not Found.
+    pub fn not_found(message: impl Into<String>) -> ApiError {
+        ApiError {
+            status: StatusCode::NOT_FOUND,
+            message: message.into(),
+        }
+    }
+
+    /// A 500 Internal Server Error.
+    pub fn internal(message: impl Into<String>) -> ApiError {
+        ApiError {
+            status: StatusCode::INTERNAL_SERVER_ERROR,
+            message: message.into(),
+        }
+    }
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let mut r = (self.status, Json(json!({ "error": self.message }))).into_response();
+        let h = r.headers_mut();
+        h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+        if self.status == StatusCode::SERVICE_UNAVAILABLE {
+            h.insert(header::RETRY_AFTER, HeaderValue::from_static("1"));
+        }
+        r
+    }
+}
+
+/// A JSON answer that browsers revalidate.
+fn json_response(v: Value, cache: &'static str) -> Response {
+    let mut r = Json(v).into_response();
+    r.headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static(cache));
+    r
+}
+
+/// The decoded query parameters (the last of repeated names wins).
+struct Params(Vec<(String, String)>);
+
+impl Params {
+    fn parse(q: Option<String>) -> Params {
+        Params(
+            q.map(|q| form_urlencoded::parse(q.as_bytes()).into_owned().collect())
+                .unwrap_or_default(),
+        )
+    }
+
+    fn get(&self, name: &str) -> Option<&str> {
+        self.0.iter().rev().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
+    }
+
+    /// A required finite number.
+    fn finite(&self, name: &str) -> Result<f64, ApiError> {
+        let raw = self.get(name).ok_or_else(|| {
+            ApiError::bad_request(format!(
+                "missing query parameter '{name}' (a finite number of metres, planet frame)"
+            ))
+        })?;
+        match raw.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            _ => Err(ApiError::bad_request(format!(
+                "query parameter '{name}' must be a finite number, got '{raw}'"
+            ))),
+        }
+    }
+
+    /// The planet the request names (or the server's).
+    fn planet(&self, state: &AppState) -> Result<PlanetId, ApiError> {
+        let c = state.config();
+        let preset = match self.get("preset") {
+            None => c.preset,
+            Some(p) => p
+                .parse::<PresetKind>()
+                .map_err(|e| ApiError::bad_request(e.to_string()))?,
+        };
+        let seed = match self.get("seed") {
+            None => c.seed,
+            Some(s) => s.trim().parse::<u64>().map_err(|_| {
+                ApiError::bad_request(format!(
+                    "seed must be a decimal integer from 0 to {}, got '{s}'",
+                    u64::MAX
+                ))
+            })?,
+        };
+        Ok((preset, seed))
+    }
+}
+
+async fn planet_of(state: &AppState, id: PlanetId) -> Result<std::sync::Arc<pmc_planet::Planet>, ApiError> {
+    state.planet(id).await.map_err(ApiError::internal)
+}
+
+/// `GET /api/v1/health`.
+pub async fn health() -> Response {
+    json_response(json!({ "ok": true, "version": env!("CARGO_PKG_VERSION") }), "no-store")
+}
+
+/// `GET /api/v1/planet`.
+pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Result<Response, ApiError> {
+    let params = Params::parse(q);
+    let id = params.planet(&state)?;
+    let planet = planet_of(&state, id).await?;
+    let l = planet.layout();
+    let t = planet.terrain();
+    let faces: Vec<Value> = Face::ALL
+        .iter()
+        .map(|f| {
+            let fr = f.frame();
+            json!({
+                "name": f.name(),
+                "index": f.index(),
+                "normal": fr.n.to_array(),
+                "u": fr.u.to_array(),
+                "v": fr.v.to_array(),
+            })
+        })
+        .collect();
+    let presets: Vec<Value> = PresetKind::ALL
+        .iter()
+        .map(|p| json!({ "name": p.name(), "description": p.description() }))
+        .collect();
+    let v = json!({
+        "format": "pmc-planet",
+        "version": 1,
+        "preset": t.kind.name(),
+        "seed": t.seed.to_string(),
+        "presets": presets,
+        "layout": { "n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c() },
+        "radius": l.radius(),
+        "base_radius": l.d_b(),
+        "sea_radius": t.sea_radius,
+        "surface_bounds": t.density.radial_bounds().map(|(a, b)| [a, b]),
+        "chunk_count": l.chunk_count(),
+        "face_tiles": l.face_tiles(),
+        "depth_tiles": l.depth_tiles(),
+        "max_level": l.max_level(),
+        "faces": faces,
+        "materials": t.materials,
+        "palette": { "a": t.blend_colors[0], "b": t.blend_colors[1] },
+    });
+    Ok(json_response(v, "no-cache"))
+}
+
+/// `GET /api/v1/chunks?x=&y=&z=&range=&limit=&level=`.
+pub async fn chunks(State(state): State<AppState>, RawQuery(q): RawQuery) -> Result<Response, ApiError> {
+    let params = Params::parse(q);
+    let id = params.planet(&state)?;
+    let p = DVec3::new(params.finite("x")?, params.finite("y")?, params.finite("z")?);
+    let range = params.finite("range")?;
+    if range <= 0.0 {
+        return Err(ApiError::bad_request(format!(
+            "range must be above 0 metres, got {range}"
+        )));
+    }
+    let limit = match params.get("limit") {
+        None => DEFAULT_LIMIT,
+        Some(s) => match s.trim().parse::<usize>() {
+            Ok(n) if (1..=MAX_LIMIT).contains(&n) => n,
+            _ => {
+                return Err(ApiError::bad_request(format!(
+                    "limit must be an integer from 1 to {MAX_LIMIT}, got '{s}'"
+                )))
+            }
+        },
+    };
+    let max_level = state.config().layout.max_level();
+    let level = match params.get("level") {
+        None => 0,
+        Some(s) => match s.trim().parse::<u8>() {
+            Ok(n) if n <= max_level => n,
+            _ => {
+                return Err(ApiError::bad_request(format!(
+                    "level must be an integer from 0 to {max_level} (this layout's max level), got '{s}'"
+                )))
+            }
+        },
+    };
+    let planet = planet_of(&state, id).await?;
+    let found = tokio::task::spawn_blocking(move || chunks_near(&planet, level, p, range, limit, MAX_TESTED_CHUNKS))
+        .await
+        .map_err(|e| ApiError::internal(format!("the chunk search failed: {e}")))?;
+    let (hits, total) = found.map_err(|TooManyChunks { budget }| {
+        ApiError::bad_request(format!(
+            "range {range} m is too large for this planet: more than {budget} chunks of level {level} lie near the \
+             point; lower range or ask for a coarser level"
+        ))
+    })?;
+    let chunks: Vec<Value> = hits
+        .iter()
+        .map(|h| {
+            let k = h.key;
+            json!({
+                "key": key_path(&k),
+                "face": k.face.name(),
+                "level": k.level,
+                "i": k.i,
+                "j": k.j,
+                "k": k.k,
+                "center": h.sphere.center.to_array(),
+                "radius": h.sphere.radius,
+                "distance": h.distance,
+            })
+        })
+        .collect();
+    Ok(json_response(
+        json!({ "chunks": chunks, "total_in_range": total }),
+        "no-cache",
+    ))
+}
+
+/// The key as the API writes it: `face/level/i/j/k`.
+pub fn key_path(k: &ChunkKey) -> String {
+    format!("{}/{}/{}/{}/{}", k.face.name(), k.level, k.i, k.j, k.k)
+}
+
+/// Parses one numeric part of a chunk path.
+fn index_part(name: &str, s: &str) -> Result<u64, ApiError> {
+    s.parse::<u64>()
+        .map_err(|_| ApiError::bad_request(format!("chunk {name} must be a non-negative integer, got '{s}'")))
+}
+
+/// The five parts of a chunk path, as text: face, level, i, j, k.
+type ChunkPath = (String, String, String, String, String);
+
+/// `GET /api/v1/chunk/{face}/{level}/{i}/{j}/{k}`.
+pub async fn chunk(
+    State(state): State<AppState>,
+    RawQuery(q): RawQuery,
+    path: Result<Path<ChunkPath>, PathRejection>,
+) -> Result<Response, ApiError> {
+    let Path((face, level, i, j, k)) = path.map_err(|e| ApiError::bad_request(format!("malformed chunk path: {e}")))?;
+    let params = Params::parse(q);
+    let id = params.planet(&state)?;
+    let face: Face = face.parse().map_err(ApiError::bad_request)?;
+    let (level, i, j, k) = (
+        index_part("level", &level)?,
+        index_part("i", &i)?,
+        index_part("j", &j)?,
+        index_part("k", &k)?,
+    );
+    let layout = state.config().layout;
+    let max_level = layout.max_level();
+    let shown = format!("{}/{level}/{i}/{j}/{k}", face.name());
+    if level > u64::from(max_level) {
+        return Err(ApiError::not_found(format!(
+            "chunk {shown} is not part of this planet: level {level} is above the layout's max level {max_level}"
+        )));
+    }
+    let level = level as u8;
+    let (n, d) = (layout.chunks_per_side(level), layout.depth_chunks(level));
+    let key = match (u32::try_from(i), u32::try_from(j), u32::try_from(k)) {
+        (Ok(i), Ok(j), Ok(k)) if i < n && j < n && k < d => ChunkKey { face, level, i, j, k },
+        _ => {
+            return Err(ApiError::not_found(format!(
+                "chunk {shown} is not part of this planet: at level {level}, i and j must be below {n} and k below {d}"
+            )))
+        }
+    };
+    if !layout.contains_chunk(&key) {
+        return Err(ApiError::not_found(format!("chunk {shown} is not part of this planet")));
+    }
+    let planet = planet_of(&state, id).await?;
+    match state.chunk(planet, ChunkId { planet: id, key }).await {
+        Ok(bytes) => {
+            let mut r = bytes.into_response();
+            let h = r.headers_mut();
+            h.insert(
+                header::CONTENT_TYPE,
+                HeaderValue::from_static("application/octet-stream"),
+            );
+            h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+            Ok(r)
+        }
+        Err(ChunkError::Busy) => Err(ApiError {
+            status: StatusCode::SERVICE_UNAVAILABLE,
+            message: "the server is busy generating chunks; retry in a second".into(),
+        }),
+        Err(ChunkError::Failed(e)) => Err(ApiError::internal(e.to_string())),
+    }
+}
+
+/// `GET /api/v1/stats`.
+pub async fn stats(State(state): State<AppState>) -> Response {
+    json_response(json!(state.stats()), "no-store")
+}
+
+/// Any other path under `/api`.
+pub async fn not_found(uri: Uri) -> ApiError {
+    ApiError::not_found(format!(
+        "no such API endpoint: {}; see docs/specs/http-api-v1.md (GET /api/v1/health, /planet, /chunks, \
+         /chunk/FACE/LEVEL/I/J/K, /stats)",
+        uri.path()
+    ))
+}
+
+/// A method other than GET (or HEAD) on an API path.
+pub async fn method_not_allowed() -> ApiError {
+    ApiError {
+        status: StatusCode::METHOD_NOT_ALLOWED,
+        message: "only GET is supported".into(),
+    }
+}

@@ -1,0 +1,454 @@
+//! Bounding spheres of chunks, and the chunks near a point.
+//!
+//! # Why the spheres bound every vertex
+//!
+//! A chunk's vertices lie on grid edges between its own voxels, so they lie in the convex hull of
+//! those voxels: points `d r` with `d` a voxel column direction of the chunk and `r` between the
+//! radii of its lowest and highest layer. The column directions lie in the image on the sphere of
+//! the chunk's rectangle of face coordinates `(u, v)`.
+//!
+//! - *A cap holds the rectangle's image.* Take the axis `a` = the direction of the rectangle's
+//!   centre and `theta` = the largest angle between `a` and the image of the rectangle's border.
+//!   The image is a disc on the sphere bounded by the border's image, it does not hold `-a` (it
+//!   lies on one face, within the face's hemisphere), and the cap `{d : angle(a, d) <= theta}` is
+//!   convex for `theta < 90 deg`; so the whole image lies in the cap. The border is sampled, and
+//!   every border point lies within half a sample spacing `s` (in `(u, v)`) of a sample; the map
+//!   `(u, v) -> direction` stretches lengths by at most 1 (its Jacobian's largest singular value
+//!   is 1, reached at the middle of the face edges; [`LIPSCHITZ`] adds a margin and a test checks
+//!   it), so `theta = max sampled angle + LIPSCHITZ s / 2` is sound.
+//! - *A sphere holds the cap between two radii.* For a centre `h a` on the axis, the squared
+//!   distance to `d r` is `(r - h)^2 + 4 r h sin^2(phi / 2)` (`phi` the angle of `d` from `a`):
+//!   largest at `phi = theta`, and convex in `r`, so largest at `r0` or `r1`. The code picks
+//!   the best of a few heights `h` and multiplies the radius by [`RADIUS_FACTOR`].
+//!
+//! # Finding the chunks near a point
+//!
+//! Each face is searched as a quadtree over its chunk columns: a node's rectangle gets a sphere as
+//! above (over the whole shell), and a node is skipped when even `2 x` the largest possible chunk
+//! sphere cannot reach the query from it (a chunk sphere holds a chunk voxel, which lies in the node
+//! sphere, so its centre is within `node radius + chunk radius` of the node's centre). So the
+//! result is exactly the brute-force list, visiting only chunks near the point.
+
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::{face_uv_to_sphere, ChunkKey, Face, Layout};
+use pmc_planet::Planet;
+
+/// Upper bound (with a 2% margin) of how much `(u, v) -> face_uv_to_sphere(face, u, v)` stretches
+/// lengths: arc length on the unit sphere per unit of `(u, v)` distance.
+pub const LIPSCHITZ: f64 = 1.02;
+/// Every sphere's radius is multiplied by this, for rounding and `f32` vertex storage.
+pub const RADIUS_FACTOR: f64 = 1.02;
+/// Beyond this cap angle (radians, about 86 degrees) a sphere around the planet centre is used.
+const MAX_CAP_ANGLE: f64 = 1.5;
+/// Border samples per side of a quadtree node.
+const NODE_SAMPLES: u32 = 16;
+
+/// A sphere, in metres, planet-centred.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundingSphere {
+    /// Centre.
+    pub center: DVec3,
+    /// Radius.
+    pub radius: f64,
+}
+
+impl BoundingSphere {
+    /// Distance from `p` to the sphere (0 inside it).
+    pub fn distance(&self, p: DVec3) -> f64 {
+        ((p - self.center).length() - self.radius).max(0.0)
+    }
+}
+
+/// A cap on the unit sphere: the directions within `angle` of `axis`.
+#[derive(Clone, Copy, Debug)]
+struct Cap {
+    axis: DVec3,
+    angle: f64,
+}
+
+/// The angle between two unit vectors, accurate for small angles.
+fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+/// The cap holding the image of the face rectangle `[u0, u1] x [v0, v1]`, from `samples + 1`
+/// samples per side of its border.
+fn rect_cap(face: Face, u0: f64, u1: f64, v0: f64, v1: f64, samples: u32) -> Cap {
+    let axis = face_uv_to_sphere(face, 0.5 * (u0 + u1), 0.5 * (v0 + v1)).normalize();
+    let mut angle: f64 = 0.0;
+    let m = f64::from(samples);
+    for s in 0..=samples {
+        let t = f64::from(s) / m;
+        let (u, v) = (u0 + (u1 - u0) * t, v0 + (v1 - v0) * t);
+        for (su, sv) in [(u, v0), (u, v1), (u0, v), (u1, v)] {
+            angle = angle.max(angle_between(axis, face_uv_to_sphere(face, su, sv).normalize()));
+        }
+    }
+    let spacing = (u1 - u0).max(v1 - v0) / m;
+    Cap {
+        axis,
+        angle: angle + LIPSCHITZ * 0.5 * spacing,
+    }
+}
+
+/// Squared distance from `h a` to a point at radius `r` and angle `angle` from `a`.
+fn dist2(r: f64, h: f64, angle: f64) -> f64 {
+    let s = (0.5 * angle).sin();
+    (r - h) * (r - h) + 4.0 * r * h * s * s
+}
+
+/// A sphere holding every point `d r` with `d` in `cap` and `r` in `[r0, r1]` (`0 < r0 <= r1`).
+fn cap_sphere(cap: Cap, r0: f64, r1: f64) -> BoundingSphere {
+    let pad = |radius: f64| radius * RADIUS_FACTOR + 1e-9 * r1;
+    if cap.angle >= MAX_CAP_ANGLE {
+        return BoundingSphere {
+            center: DVec3::ZERO,
+            radius: pad(r1),
+        };
+    }
+    let c = cap.angle.cos();
+    let (h, d2) = [r0 * c, r1 * c, 0.5 * (r0 + r1) / c, r1]
+        .into_iter()
+        .map(|h| h.clamp(0.0, r1))
+        .map(|h| (h, dist2(r0, h, cap.angle).max(dist2(r1, h, cap.angle))))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((r1, 0.0));
+    BoundingSphere {
+        center: cap.axis * h,
+        radius: pad(d2.sqrt()),
+    }
+}
+
+/// Face coordinate (`-1..=1`) of face grid index `t` of `n` tiles per side.
+fn uv(t: i64, n: i64) -> f64 {
+    2.0 * t as f64 / n as f64 - 1.0
+}
+
+/// Level-0 tiles along one axis of a chunk of `level`.
+fn span(layout: &Layout, level: u8) -> i64 {
+    i64::from(layout.n_t()) << level
+}
+
+/// The cap of the column of chunks `(face, level, i, j, *)`.
+fn column_cap(layout: &Layout, face: Face, level: u8, i: u32, j: u32) -> Cap {
+    let (n, s) = (layout.face_tiles(), span(layout, level));
+    let (ti, tj) = (i64::from(i) * s, i64::from(j) * s);
+    rect_cap(face, uv(ti, n), uv(ti + s, n), uv(tj, n), uv(tj + s, n), layout.n_t())
+}
+
+/// The radii of the lowest and highest voxel layer of chunks `k` of `level`.
+fn layer_range(layout: &Layout, level: u8, k: u32) -> (f64, f64) {
+    let s = span(layout, level);
+    (
+        layout.layer_radius(i64::from(k) * s),
+        layout.layer_radius(i64::from(k + 1) * s),
+    )
+}
+
+/// A sphere that holds every vertex chunk `key` can have. `key` must be a chunk of `layout`.
+pub fn chunk_sphere(layout: &Layout, key: &ChunkKey) -> BoundingSphere {
+    let cap = column_cap(layout, key.face, key.level, key.i, key.j);
+    let (r0, r1) = layer_range(layout, key.level, key.k);
+    cap_sphere(cap, r0, r1)
+}
+
+/// An upper bound of [`chunk_sphere`]'s radius over every chunk of `level`.
+fn max_chunk_radius(layout: &Layout, level: u8) -> f64 {
+    let (n, s) = (layout.face_tiles() as f64, span(layout, level) as f64);
+    // The largest angle a column cap can get: half diagonal plus the sampling margin (one voxel
+    // column stride), both stretched by at most LIPSCHITZ.
+    let angle = LIPSCHITZ * (std::f64::consts::SQRT_2 * s / n + (1u64 << level) as f64 / n);
+    let r = layout.radius();
+    if angle >= MAX_CAP_ANGLE {
+        return 2.0 * r;
+    }
+    // The sphere centred at h = r1 has radius^2 <= w^2 + 4 r^2 sin^2(angle / 2).
+    let w = s * layout.l_d();
+    let sin = (0.5 * angle).sin();
+    (w * w + 4.0 * r * r * sin * sin).sqrt() * RADIUS_FACTOR + 1e-9 * r
+}
+
+/// A chunk near the query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChunkHit {
+    /// The chunk.
+    pub key: ChunkKey,
+    /// Its bounding sphere.
+    pub sphere: BoundingSphere,
+    /// Distance from the query point to the sphere (0 inside).
+    pub distance: f64,
+}
+
+/// The query was too broad: more chunks to consider than the budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooManyChunks {
+    /// The budget that was exceeded.
+    pub budget: usize,
+}
+
+/// The chunks of `level` whose bounding spheres come within `range` of `point` and that may hold
+/// surface, nearest first (ties by key), with their total count; at most `limit` are returned.
+/// Fails when more than `budget` chunks would have to be tested.
+pub fn chunks_near(
+    planet: &Planet,
+    level: u8,
+    point: DVec3,
+    range: f64,
+    limit: usize,
+    budget: usize,
+) -> Result<(Vec<ChunkHit>, usize), TooManyChunks> {
+    let layout = planet.layout();
+    let mut search = Search {
+        planet,
+        layout,
+        level,
+        point,
+        range,
+        margin: 2.0 * max_chunk_radius(layout, level),
+        budget,
+        tested: 0,
+        hits: Vec::new(),
+    };
+    let n = layout.chunks_per_side(level);
+    for face in Face::ALL {
+        search.node(face, 0, n, 0, n)?;
+    }
+    let mut hits = search.hits;
+    hits.sort_by(|a, b| a.distance.total_cmp(&b.distance).then(a.key.cmp(&b.key)));
+    let total = hits.len();
+    hits.truncate(limit);
+    Ok((hits, total))
+}
+
+struct Search<'a> {
+    planet: &'a Planet,
+    layout: &'a Layout,
+    level: u8,
+    point: DVec3,
+    range: f64,
+    margin: f64,
+    budget: usize,
+    tested: usize,
+    hits: Vec<ChunkHit>,
+}
+
+impl Search<'_> {
+    /// Searches the chunk columns `[i0, i1) x [j0, j1)` of `face`.
+    fn node(&mut self, face: Face, i0: u32, i1: u32, j0: u32, j1: u32) -> Result<(), TooManyChunks> {
+        if i0 >= i1 || j0 >= j1 {
+            return Ok(());
+        }
+        if i1 - i0 == 1 && j1 - j0 == 1 {
+            return self.column(face, i0, j0);
+        }
+        let (n, s) = (self.layout.face_tiles(), span(self.layout, self.level));
+        let t = |c: u32| uv(i64::from(c) * s, n);
+        let cap = rect_cap(face, t(i0), t(i1), t(j0), t(j1), NODE_SAMPLES);
+        let sphere = cap_sphere(cap, self.layout.d_b(), self.layout.radius());
+        if (self.point - sphere.center).length() > self.range + sphere.radius + self.margin {
+            return Ok(());
+        }
+        let (im, jm) = (i0 + (i1 - i0).div_ceil(2), j0 + (j1 - j0).div_ceil(2));
+        self.node(face, i0, im, j0, jm)?;
+        self.node(face, im, i1, j0, jm)?;
+        self.node(face, i0, im, jm, j1)?;
+        self.node(face, im, i1, jm, j1)
+    }
+
+    /// Tests every chunk of the column `(face, i, j)`.
+    fn column(&mut self, face: Face, i: u32, j: u32) -> Result<(), TooManyChunks> {
+        let cap = column_cap(self.layout, face, self.level, i, j);
+        for k in 0..self.layout.depth_chunks(self.level) {
+            let key = ChunkKey {
+                face,
+                level: self.level,
+                i,
+                j,
+                k,
+            };
+            if !self.planet.may_hold_surface(&key) {
+                continue;
+            }
+            self.tested += 1;
+            if self.tested > self.budget {
+                return Err(TooManyChunks { budget: self.budget });
+            }
+            let (r0, r1) = layer_range(self.layout, self.level, k);
+            let sphere = cap_sphere(cap, r0, r1);
+            let distance = sphere.distance(self.point);
+            if distance <= self.range {
+                self.hits.push(ChunkHit { key, sphere, distance });
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pmc_planet::PresetKind;
+    use proptest::prelude::*;
+
+    /// The largest stretch of the face map, by finite differences on a dense grid.
+    #[test]
+    fn lipschitz_bound_holds() {
+        let n = 300;
+        let h = 1e-7;
+        let mut worst: f64 = 0.0;
+        for face in [Face::Top, Face::East, Face::North] {
+            for a in 0..=n {
+                for b in 0..=n {
+                    let u = (-1.0 + 2.0 * a as f64 / n as f64).clamp(-1.0 + h, 1.0 - h);
+                    let v = (-1.0 + 2.0 * b as f64 / n as f64).clamp(-1.0 + h, 1.0 - h);
+                    let su = (face_uv_to_sphere(face, u + h, v) - face_uv_to_sphere(face, u - h, v)) / (2.0 * h);
+                    let sv = (face_uv_to_sphere(face, u, v + h) - face_uv_to_sphere(face, u, v - h)) / (2.0 * h);
+                    // Largest singular value of the 3x2 Jacobian [su sv].
+                    let (p, q, r) = (su.dot(su), su.dot(sv), sv.dot(sv));
+                    let l = 0.5 * (p + r) + (0.25 * (p - r) * (p - r) + q * q).sqrt();
+                    worst = worst.max(l.sqrt());
+                }
+            }
+        }
+        assert!(worst <= 1.0 + 1e-6, "stretch {worst}");
+        assert!(worst > 0.99, "stretch {worst}: the bound should be nearly tight");
+        assert!(LIPSCHITZ >= worst * 1.01);
+    }
+
+    fn layouts() -> Vec<Layout> {
+        vec![
+            Layout::new(2, 8, 100.0, 2.0, 2).unwrap(),
+            Layout::new(1, 6, 30.0, 3.0, 1).unwrap(),
+            Layout::new(4, 4, 60.0, 4.0, 4).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn spheres_hold_every_vertex_and_voxel_and_are_tight() {
+        for layout in layouts() {
+            for preset in [PresetKind::Sphere, PresetKind::Earthlike, PresetKind::Moon] {
+                let planet = Planet::new(preset, 5, layout);
+                for level in 0..=layout.max_level() {
+                    for key in layout.chunks(level) {
+                        let s = chunk_sphere(&layout, &key);
+                        let m = planet.chunk_mesh(key);
+                        for v in 0..m.vertex_count() {
+                            let d = (m.world_position(v) - s.center).length();
+                            assert!(d <= s.radius, "{key}: vertex at {d} outside {}", s.radius);
+                        }
+                        // The voxels of the chunk, and how tight the sphere is around them.
+                        let grid = pmc_geometry::ChunkGrid::new(&layout, key);
+                        let mut far: f64 = 0.0;
+                        for c in 1..=grid.tiles + 1 {
+                            for b in 1..=grid.tiles + 1 {
+                                for a in 1..=grid.tiles + 1 {
+                                    far = far.max((grid.position(a, b, c) - s.center).length());
+                                }
+                            }
+                        }
+                        assert!(far <= s.radius, "{key}: voxel at {far} outside {}", s.radius);
+                        assert!(
+                            s.radius <= 1.35 * far,
+                            "{key}: radius {} for voxels within {far}",
+                            s.radius
+                        );
+                        assert!(s.radius <= max_chunk_radius(&layout, level), "{key}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn spheres_stay_tight_at_earth_radius() {
+        let layout = Layout::new(1 << 17, 32, 6.37e6, 2.0, 2).unwrap();
+        let key = ChunkKey::new(Face::South, 70_000, 3_000, 1);
+        let s = chunk_sphere(&layout, &key);
+        let grid = pmc_geometry::ChunkGrid::new(&layout, key);
+        let mut far: f64 = 0.0;
+        for c in [1, grid.tiles + 1] {
+            for b in 1..=grid.tiles + 1 {
+                for a in 1..=grid.tiles + 1 {
+                    far = far.max((grid.position(a, b, c) - s.center).length());
+                }
+            }
+        }
+        assert!(far <= s.radius && s.radius <= 1.35 * far, "{} vs {far}", s.radius);
+    }
+
+    fn brute_force(planet: &Planet, level: u8, p: DVec3, range: f64) -> Vec<ChunkHit> {
+        let layout = planet.layout();
+        let mut v: Vec<ChunkHit> = layout
+            .chunks(level)
+            .into_iter()
+            .filter(|k| planet.may_hold_surface(k))
+            .map(|key| {
+                let sphere = chunk_sphere(layout, &key);
+                ChunkHit {
+                    key,
+                    sphere,
+                    distance: sphere.distance(p),
+                }
+            })
+            .filter(|h| h.distance <= range)
+            .collect();
+        v.sort_by(|a, b| a.distance.total_cmp(&b.distance).then(a.key.cmp(&b.key)));
+        v
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn quadtree_search_equals_brute_force(
+            dir in [-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0],
+            dist in 0.0f64..3.0,
+            range in 0.1f64..400.0,
+            level in 0u8..3,
+        ) {
+            let layout = Layout::new(8, 4, 100.0, 2.0, 4).unwrap();
+            let planet = Planet::new(PresetKind::Earthlike, 3, layout);
+            let level = level.min(layout.max_level());
+            let d = DVec3::from_array(dir);
+            let p = if d.length() < 1e-6 { DVec3::ZERO } else { d.normalize() * dist * layout.radius() };
+            let (hits, total) = chunks_near(&planet, level, p, range, usize::MAX, usize::MAX).unwrap();
+            let expected = brute_force(&planet, level, p, range);
+            prop_assert_eq!(total, expected.len());
+            prop_assert_eq!(hits, expected);
+        }
+    }
+
+    #[test]
+    fn limit_budget_and_order() {
+        let layout = Layout::new(8, 4, 100.0, 2.0, 4).unwrap();
+        let planet = Planet::new(PresetKind::Sphere, 1, layout);
+        let p = DVec3::new(0.0, layout.radius(), 0.0);
+        let (all, total) = chunks_near(&planet, 0, p, 1e9, usize::MAX, usize::MAX).unwrap();
+        assert_eq!(total, all.len());
+        assert_eq!(
+            total,
+            layout.chunks(0).iter().filter(|k| planet.may_hold_surface(k)).count()
+        );
+        assert!(all.windows(2).all(|w| w[0].distance <= w[1].distance));
+        assert_eq!(all[0].key.face, Face::Top);
+        let (few, total2) = chunks_near(&planet, 0, p, 1e9, 5, usize::MAX).unwrap();
+        assert_eq!((few.as_slice(), total2), (&all[..5], total));
+        assert_eq!(
+            chunks_near(&planet, 0, p, 1e9, 5, 10),
+            Err(TooManyChunks { budget: 10 })
+        );
+    }
+
+    #[test]
+    fn huge_layouts_search_only_near_the_point() {
+        // 6 * 2^34 chunks: only those near the point are looked at.
+        let layout = Layout::new(1 << 17, 32, 6.37e6, 2.0, 2).unwrap();
+        let planet = Planet::new(PresetKind::Earthlike, 1, layout);
+        let p = pmc_geometry::LatLon::new(10.0, 20.0).unwrap().to_unit() * planet.datum_radius();
+        let (hits, total) = chunks_near(&planet, 0, p, 500.0, 4096, 20_000).unwrap();
+        assert!(total > 0 && total == hits.len(), "{total}");
+        for h in &hits {
+            assert!(h.sphere.distance(p) <= 500.0);
+        }
+        assert!(chunks_near(&planet, 0, p, 1e6, 4096, 20_000).is_err());
+    }
+}

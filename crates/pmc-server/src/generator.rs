@@ -1,0 +1,173 @@
+//! Chunk generation off the async runtime: a worker pool, a bounded queue, in-flight
+//! de-duplication and a cache of encoded chunks bounded by bytes.
+
+use crate::lru::ByteLru;
+use axum::body::Bytes;
+use pmc_formats::chunk_encoding::encode_chunk;
+use pmc_geometry::ChunkKey;
+use pmc_mesh::ChunkMesh;
+use pmc_planet::{ChunkScratch, Planet, PresetKind};
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use tokio::sync::watch;
+
+/// A planet's identity: preset and seed (the layout is the server's).
+pub(crate) type PlanetId = (PresetKind, u64);
+
+/// A chunk of a planet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct ChunkId {
+    pub planet: PlanetId,
+    pub key: ChunkKey,
+}
+
+/// The outcome of one job, shared by every request that waited for it.
+type JobResult = Result<Bytes, Arc<str>>;
+
+/// Why a chunk could not be served.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum ChunkError {
+    /// The queue is full: try again shortly.
+    Busy,
+    /// Generation failed (a bug); the message says how.
+    Failed(Arc<str>),
+}
+
+/// Counters for `/api/v1/stats`.
+#[derive(Debug, Default)]
+pub(crate) struct Counters {
+    /// Chunks generated (each generation counted once, however many requests waited for it).
+    pub generated: AtomicU64,
+    /// Jobs waiting for a worker.
+    pub queued: AtomicUsize,
+    /// Jobs being generated.
+    pub in_flight: AtomicUsize,
+    /// Requests answered 503 because the queue was full.
+    pub rejected_busy: AtomicU64,
+}
+
+struct Store {
+    cache: ByteLru<ChunkId, Bytes>,
+    pending: HashMap<ChunkId, watch::Receiver<Option<JobResult>>>,
+}
+
+/// Generates, de-duplicates and caches encoded chunks.
+pub(crate) struct Generator {
+    store: Mutex<Store>,
+    pool: rayon::ThreadPool,
+    queue_limit: usize,
+    /// The counters.
+    pub counters: Counters,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<ChunkScratch> = RefCell::new(ChunkScratch::default());
+}
+
+/// Meshes and encodes one chunk (on a worker thread).
+fn generate(planet: &Planet, key: ChunkKey) -> Result<Bytes, String> {
+    let mut mesh = ChunkMesh::default();
+    SCRATCH.with(|s| planet.chunk_mesh_into(key, &mut s.borrow_mut(), &mut mesh));
+    let mut out = Vec::new();
+    encode_chunk(&mesh, &mut out).map_err(|e| e.to_string())?;
+    Ok(Bytes::from(out))
+}
+
+impl Generator {
+    /// A generator with `threads` workers (0: one per core), at most `queue_limit` waiting jobs
+    /// and `cache_bytes` of cache.
+    pub fn new(threads: usize, queue_limit: usize, cache_bytes: u64) -> Result<Generator, String> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("pmc-chunk-{i}"))
+            .build()
+            .map_err(|e| e.to_string())?;
+        Ok(Generator {
+            store: Mutex::new(Store {
+                cache: ByteLru::new(cache_bytes),
+                pending: HashMap::new(),
+            }),
+            pool,
+            queue_limit,
+            counters: Counters::default(),
+        })
+    }
+
+    fn store(&self) -> MutexGuard<'_, Store> {
+        self.store.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// The encoded chunk `id` of `planet`: from the cache, from a job already running for it, or
+    /// from a new job (refused with [`ChunkError::Busy`] when the queue is full). `id.key` must be
+    /// a chunk of the planet's layout.
+    pub async fn chunk(self: &Arc<Self>, planet: Arc<Planet>, id: ChunkId) -> Result<Bytes, ChunkError> {
+        let mut rx = {
+            let mut store = self.store();
+            if let Some(bytes) = store.cache.get(&id) {
+                return Ok(bytes.clone());
+            }
+            match store.pending.get(&id) {
+                Some(rx) => rx.clone(),
+                None => {
+                    if self.counters.queued.load(Ordering::SeqCst) >= self.queue_limit {
+                        self.counters.rejected_busy.fetch_add(1, Ordering::Relaxed);
+                        return Err(ChunkError::Busy);
+                    }
+                    let (tx, rx) = watch::channel(None);
+                    store.pending.insert(id, rx.clone());
+                    self.counters.queued.fetch_add(1, Ordering::SeqCst);
+                    let this = Arc::clone(self);
+                    self.pool.spawn(move || this.run_job(&planet, id, tx));
+                    rx
+                }
+            }
+        };
+        let result = match rx.wait_for(Option::is_some).await {
+            Ok(r) => r.clone(),
+            Err(_) => None,
+        };
+        match result {
+            Some(Ok(bytes)) => Ok(bytes),
+            Some(Err(e)) => Err(ChunkError::Failed(e)),
+            None => Err(ChunkError::Failed("the generation job was dropped".into())),
+        }
+    }
+
+    /// Runs one job on a worker: generate, cache, wake the waiters.
+    fn run_job(&self, planet: &Planet, id: ChunkId, tx: watch::Sender<Option<JobResult>>) {
+        self.counters.queued.fetch_sub(1, Ordering::SeqCst);
+        self.counters.in_flight.fetch_add(1, Ordering::SeqCst);
+        let result: JobResult =
+            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| generate(planet, id.key))) {
+                Ok(Ok(bytes)) => Ok(bytes),
+                Ok(Err(e)) => Err(format!("chunk {} could not be encoded: {e}", id.key).into()),
+                Err(_) => Err(format!("generating chunk {} panicked; this is a bug in pmc", id.key).into()),
+            };
+        self.counters.in_flight.fetch_sub(1, Ordering::SeqCst);
+        if result.is_ok() {
+            self.counters.generated.fetch_add(1, Ordering::Relaxed);
+        }
+        {
+            // Cache and un-register under one lock, so a new request sees one or the other.
+            let mut store = self.store();
+            if let Ok(bytes) = &result {
+                store.cache.insert(id, bytes.clone(), bytes.len() as u64);
+            }
+            store.pending.remove(&id);
+        }
+        tx.send_replace(Some(result));
+    }
+
+    /// Drops the cached chunks of `planet`.
+    pub fn forget_planet(&self, planet: PlanetId) {
+        self.store().cache.retain(|id| id.planet != planet);
+    }
+
+    /// Cached chunks and their bytes.
+    pub fn cache_usage(&self) -> (usize, u64) {
+        let store = self.store();
+        (store.cache.len(), store.cache.bytes())
+    }
+}

@@ -1,0 +1,41 @@
+//! The PMC HTTP server: streams a planet's chunk meshes to the web viewer.
+//!
+//! It implements `docs/specs/http-api-v1.md` (endpoints) and `docs/specs/chunk-mesh-v1.md` (the
+//! binary chunk encoding, written by [`pmc_formats::chunk_encoding`]), and serves the viewer's
+//! built files, embedded in the binary.
+//!
+//! - Chunks are generated on demand on a worker pool (never on the async runtime), cached as
+//!   encoded bytes in an LRU bounded by [`ServerConfig::cache_bytes`], and concurrent requests
+//!   for one chunk share one generation. More than [`ServerConfig::queue_limit`] waiting jobs
+//!   make new chunk requests answer 503 with `Retry-After: 1`.
+//! - Requests may name any preset and seed; the [`ServerConfig::max_planets`] most recently used
+//!   planets are kept, each with its cached chunks.
+//! - `/chunks` finds the chunks near a point with a quadtree per face over provable bounding
+//!   spheres (see [`bounds`]), so it stays fast on planets of any size.
+//! - Every malformed request gets a 4xx with a JSON `{"error": ...}`; no request can panic the
+//!   server.
+//!
+//! ```no_run
+//! # async fn run() -> Result<(), pmc_server::ServerError> {
+//! use pmc_server::{serve, shutdown_signal, ServerConfig};
+//! serve(ServerConfig { port: 8080, ..Default::default() }, shutdown_signal()).await
+//! # }
+//! ```
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod api;
+pub mod assets;
+pub mod bounds;
+mod config;
+mod error;
+mod generator;
+mod lru;
+mod planets;
+mod server;
+mod state;
+
+pub use config::ServerConfig;
+pub use error::ServerError;
+pub use server::{router, serve, shutdown_signal, Server};
+pub use state::{AppState, Stats};

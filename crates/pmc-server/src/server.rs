@@ -1,0 +1,155 @@
+//! The router, listening, and shutdown.
+
+use crate::{api, assets, AppState, ServerConfig, ServerError};
+use axum::extract::Request;
+use axum::http::{header, HeaderValue, StatusCode};
+use axum::middleware::{self, Next};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{any, get};
+use axum::Router;
+use std::future::Future;
+use std::net::SocketAddr;
+use std::time::Instant;
+use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::compression::CompressionLayer;
+
+/// Logs one line per request at debug level.
+async fn log_request(req: Request, next: Next) -> Response {
+    let (method, path) = (req.method().clone(), req.uri().path().to_owned());
+    let start = Instant::now();
+    let res = next.run(req).await;
+    tracing::debug!(
+        target: "pmc_server::request",
+        "{method} {path} {} {:.1} ms",
+        res.status().as_u16(),
+        start.elapsed().as_secs_f64() * 1e3
+    );
+    res
+}
+
+/// The answer when a handler panicked (it never should).
+fn panic_response(_: Box<dyn std::any::Any + Send + 'static>) -> Response {
+    tracing::error!("a request handler panicked; this is a bug in pmc");
+    let mut r = (
+        StatusCode::INTERNAL_SERVER_ERROR,
+        axum::Json(serde_json::json!({ "error": "internal error (a bug in pmc); see the server log" })),
+    )
+        .into_response();
+    r.headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    r
+}
+
+/// The HTTP routes of `docs/specs/http-api-v1.md` plus the embedded viewer, with gzip
+/// compression, request logging and a guard that turns a panic into a 500.
+pub fn router(state: AppState) -> Router {
+    Router::new()
+        .route("/api/v1/health", get(api::health))
+        .route("/api/v1/planet", get(api::planet))
+        .route("/api/v1/chunks", get(api::chunks))
+        .route("/api/v1/chunk/{face}/{level}/{i}/{j}/{k}", get(api::chunk))
+        .route("/api/v1/stats", get(api::stats))
+        .route("/api", any(api::not_found))
+        .route("/api/", any(api::not_found))
+        .route("/api/{*rest}", any(api::not_found))
+        .method_not_allowed_fallback(api::method_not_allowed)
+        .fallback(assets::static_file)
+        .with_state(state)
+        .layer(middleware::from_fn(log_request))
+        .layer(CatchPanicLayer::custom(panic_response))
+        .layer(CompressionLayer::new())
+}
+
+/// A server bound to its address, not yet answering.
+#[derive(Debug)]
+pub struct Server {
+    listener: tokio::net::TcpListener,
+    addr: SocketAddr,
+    state: AppState,
+}
+
+impl Server {
+    /// Checks `config`, starts the workers and binds `host:port` (port 0 picks a free one).
+    pub async fn bind(config: ServerConfig) -> Result<Server, ServerError> {
+        let addr = SocketAddr::new(config.host, config.port);
+        let state = AppState::new(config)?;
+        let listener = tokio::net::TcpListener::bind(addr)
+            .await
+            .map_err(|e| ServerError::bind(addr, e))?;
+        let addr = listener.local_addr().map_err(|e| ServerError::bind(addr, e))?;
+        Ok(Server { listener, addr, state })
+    }
+
+    /// The bound address (with the real port when 0 was asked for).
+    pub fn local_addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// The viewer's URL, `http://HOST:PORT/`.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.addr)
+    }
+
+    /// The shared state.
+    pub fn state(&self) -> &AppState {
+        &self.state
+    }
+
+    /// Answers requests until `shutdown` completes, then lets open requests finish.
+    pub async fn run(self, shutdown: impl Future<Output = ()> + Send + 'static) -> Result<(), ServerError> {
+        let c = self.state.config();
+        tracing::info!(
+            "PMC server listening on {}: preset {} seed {}, layout n_c={} n_t={} d_b={} l_d={} d_c={}{}",
+            self.url(),
+            c.preset,
+            c.seed,
+            c.layout.n_c(),
+            c.layout.n_t(),
+            c.layout.d_b(),
+            c.layout.l_d(),
+            c.layout.d_c(),
+            if assets::viewer_is_built() {
+                ""
+            } else {
+                " (viewer not built: / shows how to build it)"
+            }
+        );
+        axum::serve(self.listener, router(self.state))
+            .with_graceful_shutdown(shutdown)
+            .await?;
+        tracing::info!("PMC server stopped");
+        Ok(())
+    }
+}
+
+/// Binds per `config` and serves until `shutdown` completes.
+pub async fn serve(
+    config: ServerConfig,
+    shutdown: impl Future<Output = ()> + Send + 'static,
+) -> Result<(), ServerError> {
+    Server::bind(config).await?.run(shutdown).await
+}
+
+/// Completes on Ctrl-C (SIGINT) or, on Unix, SIGTERM.
+pub async fn shutdown_signal() {
+    let ctrl_c = async {
+        if tokio::signal::ctrl_c().await.is_err() {
+            std::future::pending::<()>().await;
+        }
+    };
+    #[cfg(unix)]
+    let term = async {
+        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
+            Ok(mut s) => {
+                s.recv().await;
+            }
+            Err(_) => std::future::pending::<()>().await,
+        }
+    };
+    #[cfg(not(unix))]
+    let term = std::future::pending::<()>();
+    tokio::select! {
+        () = ctrl_c => {},
+        () = term => {},
+    }
+}

@@ -1,0 +1,553 @@
+// The viewer application: wires the API, the streamer, the scene, the camera model, the input,
+// the UI, the URL hash and the test hook together, and runs the frame loop.
+
+import * as THREE from 'three';
+import { PmcApi, type PlanetInfo } from './api';
+import {
+  cameraPosition,
+  flyMove,
+  flySpeed,
+  look,
+  maxAltitude,
+  minOrbitAltitude,
+  orbitDrag,
+  orbitZoom,
+  toFly,
+  toOrbit,
+  type CameraMode,
+  type CameraState,
+} from './cameraModel';
+import { ChunkStreamer } from './chunkStreamer';
+import { loadRange } from './chunkSelection';
+import { addScaled, cameraBasis, enuAt, length, normalize, wrapLon, type V3 } from './frames';
+import { Input } from './input';
+import { planetParams, type PlanetParams } from './planetParams';
+import { PlanetScene, type DebugFlags } from './planetScene';
+import { Ui } from './ui';
+import { formatHash, parseHash, type UrlState } from './urlState';
+
+export type ModeName = CameraMode | 'walk';
+
+export interface PmcStats {
+  preset: string | null;
+  seed: string | null;
+  loaded: number;
+  pending: number;
+  missing: number;
+  triangles: number;
+  vertices: number;
+  requested: number;
+  failed: number;
+  fps: number;
+  frames: number;
+  lat: number;
+  lon: number;
+  alt: number;
+  heading: number;
+  pitch: number;
+  aboveGround: number | null;
+  mode: CameraMode;
+  walk: boolean;
+  range: number;
+  drawCalls: number;
+  ready: boolean;
+  error: string | null;
+  loadedKeys: string[];
+}
+
+export interface PmcTestHook {
+  stats(): PmcStats;
+  /** Resolves when no chunk is pending or missing and at least one is loaded and drawn. */
+  ready(timeoutMs?: number): Promise<void>;
+  setCamera(lat: number, lon: number, altitude: number, headingDeg?: number, pitchDeg?: number): void;
+  setPlanet(preset: string, seed: string | number): Promise<void>;
+  /** Switches to `name` ('orbit', 'fly' or 'walk') when given; returns the current mode. */
+  mode(name?: ModeName): ModeName;
+  debug(flags: Partial<DebugFlags>): DebugFlags;
+}
+
+declare global {
+  interface Window {
+    __pmc?: PmcTestHook;
+  }
+}
+
+const FOV = 50;
+const EYE_HEIGHT = 2;
+const STEP_CLIMB = 1.5;
+
+export class App {
+  private readonly api = new PmcApi('api/v1');
+  private readonly renderer: THREE.WebGLRenderer;
+  private readonly camera = new THREE.PerspectiveCamera(FOV, 1, 0.1, 1e5);
+  private readonly scene = new PlanetScene();
+  private readonly streamer: ChunkStreamer;
+  private readonly ui: Ui;
+  private readonly input: Input;
+  private readonly raycaster = new THREE.Raycaster();
+  private readonly frustum = new THREE.Frustum();
+  private readonly projView = new THREE.Matrix4();
+  private readonly tmpSphere = new THREE.Sphere();
+
+  private params: PlanetParams | null = null;
+  private choice: { preset?: string; seed?: string } = {};
+  private planetRequest = 0;
+  private planetBusy: string | null = null;
+
+  private state: CameraState = { lat: 20, lon: 15, alt: NaN, heading: 0, pitch: -90 };
+  private mode: CameraMode = 'orbit';
+  private walk = false;
+  private speedFactor = 1;
+  private aboveGround: number | null = null;
+  private range = 1;
+
+  private lastFrame = performance.now();
+  private frames = 0;
+  private fps = 0;
+  private fpsFrames = 0;
+  private fpsSince = performance.now();
+  private lastUiUpdate = 0;
+  private lastHashWrite = 0;
+  private writtenHash = '';
+  private settledFrames = 0;
+  private readyWaiters: { resolve: () => void; reject: (e: Error) => void; timer: number }[] = [];
+  private error: string | null = null;
+
+  constructor(private readonly canvas: HTMLCanvasElement) {
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, powerPreference: 'high-performance' });
+    this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+    this.renderer.outputColorSpace = THREE.SRGBColorSpace;
+    this.camera.position.set(0, 0, 0);
+    this.camera.matrixAutoUpdate = false;
+
+    this.streamer = new ChunkStreamer(this.api, {
+      onLoad: (key, chunk, bounds) => this.scene.addChunk(key, chunk, bounds),
+      onUnload: (key) => this.scene.removeChunk(key),
+      onError: (message) => this.showError(message),
+      onRecovered: () => this.clearError(),
+    });
+    this.ui = new Ui({
+      onPlanet: (preset, seed) => void this.setPlanet(preset, seed).catch(() => undefined),
+      onMode: (mode) => this.setMode(mode),
+      onWalk: (walk) => this.setWalk(walk),
+      onDebug: (flags) => {
+        this.scene.setDebug(flags);
+        this.ui.setDebug(this.scene.debug());
+      },
+    });
+    this.input = new Input(canvas, {
+      onToggleMode: () => this.setMode(this.mode === 'orbit' ? 'fly' : 'orbit'),
+      onToggleWalk: () => {
+        if (this.mode === 'fly') this.setWalk(!this.walk);
+      },
+    });
+    canvas.addEventListener('dblclick', () => {
+      if (this.mode === 'fly') this.input.requestPointerLock();
+    });
+    window.addEventListener('resize', () => this.resize());
+    window.addEventListener('hashchange', () => this.onHashChange());
+    this.resize();
+
+    const fromHash = parseHash(location.hash);
+    this.applyUrlState(fromHash, false);
+    this.choice = { ...(fromHash.preset ? { preset: fromHash.preset } : {}), ...(fromHash.seed ? { seed: fromHash.seed } : {}) };
+    this.ui.setMode(this.mode, this.walk);
+    this.ui.setDebug(this.scene.debug());
+    window.__pmc = this.testHook();
+    this.renderer.setAnimationLoop(() => this.frame());
+    void this.loadPlanet(this.choice, true);
+  }
+
+  // ---- planet -------------------------------------------------------------------------------
+
+  /** Fetches `/planet` for `choice` and restarts streaming; retries at start-up. */
+  private async loadPlanet(choice: { preset?: string; seed?: string }, retry: boolean): Promise<void> {
+    const request = ++this.planetRequest;
+    this.planetBusy = 'loading planet';
+    let attempt = 0;
+    for (;;) {
+      try {
+        const info = await this.api.planet(choice);
+        if (request !== this.planetRequest) return;
+        this.applyPlanet(info);
+        this.clearError();
+        return;
+      } catch (e) {
+        if (request !== this.planetRequest) return;
+        const message = e instanceof Error ? e.message : String(e);
+        this.showError(`Cannot load the planet: ${message}`);
+        if (!retry) {
+          this.planetBusy = null;
+          throw e instanceof Error ? e : new Error(message);
+        }
+        attempt++;
+        await new Promise((r) => setTimeout(r, Math.min(10_000, 500 * 2 ** attempt)));
+        if (request !== this.planetRequest) return;
+      }
+    }
+  }
+
+  private applyPlanet(info: PlanetInfo): void {
+    this.params = planetParams(info);
+    this.choice = { preset: info.preset, seed: info.seed };
+    this.streamer.setPlanet(this.choice);
+    this.scene.clearChunks();
+    this.scene.setPlanet(this.params);
+    const shape = this.params.shape;
+    if (!Number.isFinite(this.state.alt)) this.state.alt = 1.6 * shape.outer;
+    this.clampAltitude();
+    this.ui.setPresets(info.presets, info.preset);
+    this.ui.setPlanet(info.preset, info.seed);
+    this.planetBusy = null;
+    this.settledFrames = 0;
+    this.writeHash(true);
+  }
+
+  async setPlanet(preset: string, seed: string | number): Promise<void> {
+    const s = String(seed);
+    this.ui.setPlanet(preset, s);
+    try {
+      await this.loadPlanet({ preset, seed: s }, false);
+    } catch (e) {
+      // keep showing the planet that is still there
+      if (this.choice.preset && this.choice.seed) this.ui.setPlanet(this.choice.preset, this.choice.seed);
+      throw e;
+    }
+  }
+
+  // ---- camera -------------------------------------------------------------------------------
+
+  private clampAltitude(): void {
+    if (!this.params) return;
+    const shape = this.params.shape;
+    const min = this.mode === 'orbit' ? minOrbitAltitude(shape) : -shape.datum + 1;
+    this.state.alt = Math.min(maxAltitude(shape), Math.max(min, this.state.alt));
+  }
+
+  setMode(mode: CameraMode): void {
+    if (mode === this.mode) return;
+    this.mode = mode;
+    if (mode === 'orbit') {
+      this.walk = false;
+      this.input.releasePointerLock();
+      if (this.params) this.state = toOrbit(this.state, this.params.shape);
+    } else {
+      this.state = toFly(this.state);
+    }
+    this.clampAltitude();
+    this.ui.setMode(this.mode, this.walk);
+    this.writeHash(true);
+  }
+
+  setWalk(walk: boolean): void {
+    if (walk && this.mode !== 'fly') this.setMode('fly');
+    this.walk = walk;
+    if (walk) this.state.pitch = Math.max(-60, Math.min(60, this.state.pitch));
+    this.ui.setMode(this.mode, this.walk);
+    this.writeHash(true);
+  }
+
+  setCamera(lat: number, lon: number, alt: number, heading?: number, pitch?: number): void {
+    if (![lat, lon, alt].every(Number.isFinite)) throw new Error('setCamera: lat, lon and altitude must be finite numbers');
+    const s: CameraState = {
+      lat: Math.max(-90, Math.min(90, lat)),
+      lon: wrapLon(lon),
+      alt,
+      heading: heading ?? this.state.heading,
+      pitch: pitch ?? this.state.pitch,
+    };
+    // a view that is not straight down needs the fly mode
+    if (pitch !== undefined && pitch > -89.5 && this.mode === 'orbit') {
+      this.mode = 'fly';
+      this.ui.setMode(this.mode, this.walk);
+    }
+    if (this.mode === 'orbit') s.pitch = -90;
+    this.state = s;
+    this.clampAltitude();
+    this.settledFrames = 0;
+    this.writeHash(true);
+  }
+
+  private applyUrlState(u: UrlState, fromUser: boolean): void {
+    if (u.mode) this.mode = u.mode;
+    if (u.walk !== undefined) this.walk = u.walk && this.mode === 'fly';
+    const s = this.state;
+    if (u.lat !== undefined) s.lat = u.lat;
+    if (u.lon !== undefined) s.lon = wrapLon(u.lon);
+    if (u.alt !== undefined) s.alt = u.alt;
+    if (u.heading !== undefined) s.heading = u.heading;
+    if (u.pitch !== undefined) s.pitch = Math.max(-90, Math.min(90, u.pitch));
+    if (this.mode === 'orbit') s.pitch = -90;
+    this.clampAltitude();
+    if (fromUser) this.ui.setMode(this.mode, this.walk);
+  }
+
+  private onHashChange(): void {
+    if (location.hash === this.writtenHash) return;
+    const u = parseHash(location.hash);
+    this.applyUrlState(u, true);
+    const preset = u.preset ?? this.choice.preset;
+    const seed = u.seed ?? this.choice.seed;
+    if (preset !== this.choice.preset || seed !== this.choice.seed) {
+      void this.loadPlanet({ ...(preset ? { preset } : {}), ...(seed ? { seed } : {}) }, false).catch(() => undefined);
+    }
+  }
+
+  private writeHash(force: boolean): void {
+    const now = performance.now();
+    if (!force && now - this.lastHashWrite < 500) return;
+    this.lastHashWrite = now;
+    const s = this.state;
+    const hash = formatHash({
+      ...(this.choice.preset ? { preset: this.choice.preset } : {}),
+      ...(this.choice.seed ? { seed: this.choice.seed } : {}),
+      mode: this.mode,
+      walk: this.walk,
+      ...(Number.isFinite(s.alt) ? { lat: s.lat, lon: s.lon, alt: s.alt, heading: s.heading, pitch: s.pitch } : {}),
+    });
+    if (hash !== this.writtenHash && hash !== location.hash) {
+      this.writtenHash = hash;
+      history.replaceState(null, '', hash);
+    }
+  }
+
+  // ---- frame loop ---------------------------------------------------------------------------
+
+  private resize(): void {
+    const w = Math.max(1, this.canvas.clientWidth || window.innerWidth);
+    const h = Math.max(1, this.canvas.clientHeight || window.innerHeight);
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+  }
+
+  /** Distance down to the loaded terrain from `from` (render space), or null without a hit. */
+  private groundDistance(from: V3, up: V3, maxDistance: number): number | null {
+    this.raycaster.set(new THREE.Vector3(from[0], from[1], from[2]), new THREE.Vector3(-up[0], -up[1], -up[2]));
+    this.raycaster.near = 0;
+    this.raycaster.far = maxDistance;
+    const hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
+    return hits.length > 0 ? hits[0]!.distance : null;
+  }
+
+  private frame(): void {
+    const now = performance.now();
+    const dt = Math.min(0.1, Math.max(0, (now - this.lastFrame) / 1000));
+    this.lastFrame = now;
+    this.frames++;
+    this.fpsFrames++;
+    if (now - this.fpsSince >= 500) {
+      this.fps = (this.fpsFrames * 1000) / (now - this.fpsSince);
+      this.fpsFrames = 0;
+      this.fpsSince = now;
+    }
+    const params = this.params;
+    const input = this.input.take();
+    if (!params) {
+      this.renderer.render(this.scene.scene, this.camera);
+      this.ui.setLoading(0, 0, this.planetBusy ?? 'waiting for the server');
+      return;
+    }
+    const shape = params.shape;
+    const viewportHeight = this.canvas.clientHeight || window.innerHeight;
+    let moved = false;
+    if (this.mode === 'orbit') {
+      if (input.dragX !== 0 || input.dragY !== 0) {
+        this.state = orbitDrag(this.state, shape, input.dragX, input.dragY, viewportHeight, FOV);
+        moved = true;
+      }
+      if (input.wheel !== 0) {
+        this.state = orbitZoom(this.state, shape, input.wheel);
+        moved = true;
+      }
+    } else {
+      if (input.dragX !== 0 || input.dragY !== 0) {
+        this.state = look(this.state, input.dragX * 0.15, -input.dragY * 0.15);
+        if (this.walk) this.state.pitch = Math.max(-80, Math.min(80, this.state.pitch));
+        moved = true;
+      }
+      if (input.wheel !== 0) {
+        this.speedFactor = Math.min(100, Math.max(0.01, this.speedFactor * Math.exp(-input.wheel * 0.001)));
+      }
+      if (input.forward !== 0 || input.right !== 0 || input.up !== 0) {
+        const r = length(cameraPosition(this.state, shape));
+        const height = this.aboveGround ?? Math.max(1, r - shape.outer);
+        const speed = flySpeed(this.walk ? 3 : height) * this.speedFactor * (input.fast ? 4 : 1);
+        this.state = flyMove(this.state, shape, input, dt, speed, this.walk).state;
+        moved = true;
+      }
+    }
+    this.clampAltitude();
+    let pos = cameraPosition(this.state, shape);
+    this.scene.place(pos);
+    this.scene.scene.updateMatrixWorld();
+
+    // ground: walk snaps the eye above it; fly measures it (every few frames)
+    const up = normalize(pos);
+    if (this.walk) {
+      const probe = STEP_CLIMB - EYE_HEIGHT; // ray origin relative to the eye, along up
+      const d = this.groundDistance(addScaled([0, 0, 0], up, probe), up, 5000);
+      if (d !== null) {
+        const below = d - probe; // height of the eye above the ground now
+        const want = EYE_HEIGHT - below;
+        // climb at once, fall at most 25 m/s
+        const adjust = want > 0 ? want : Math.max(want, -25 * Math.max(dt, 1 / 60));
+        this.state.alt += adjust;
+        this.aboveGround = below + adjust;
+        pos = cameraPosition(this.state, shape);
+        this.scene.place(pos);
+        this.scene.scene.updateMatrixWorld();
+        moved = true;
+      }
+    } else if (this.mode === 'fly' && (this.frames % 6 === 0 || moved)) {
+      this.aboveGround = this.groundDistance([0, 0, 0], up, 4 * shape.outer);
+    } else if (this.mode === 'orbit') {
+      this.aboveGround = null;
+    }
+
+    // camera orientation and clip planes
+    const basis = cameraBasis(pos, this.state.heading, this.state.pitch);
+    const m = new THREE.Matrix4().makeBasis(
+      new THREE.Vector3(...basis.right),
+      new THREE.Vector3(...basis.up),
+      new THREE.Vector3(-basis.forward[0], -basis.forward[1], -basis.forward[2]),
+    );
+    this.camera.matrix.copy(m);
+    this.camera.matrixWorld.copy(m);
+    this.camera.matrixWorldInverse.copy(m).invert();
+    const r = length(pos);
+    const aboveTop = r - shape.outer;
+    const nearFromGround = this.aboveGround !== null ? this.aboveGround * 0.3 : Infinity;
+    this.camera.near = Math.max(0.05, Math.min(aboveTop > 0 ? aboveTop * 0.4 : 0.1, nearFromGround, 1e5));
+    this.range = loadRange(r, params.extent, Math.max(4 * params.chunkWidth, 100));
+    this.camera.far = Math.max(this.camera.near * 10, this.range * 1.05 + params.chunkWidth);
+    this.camera.updateProjectionMatrix();
+
+    // sky: blue near the ground, black from orbit
+    const aboveSea = r - (params.seaRadius ?? shape.datum);
+    const skyT = (aboveSea - 0.04 * shape.datum) / (0.5 * shape.datum);
+    this.scene.setSky(1 - Math.max(0, Math.min(1, skyT)) ** 0.5);
+
+    // sun: above the camera's side of the planet, from the south-east-ish
+    const enu = enuAt(pos);
+    this.scene.setSun(normalize(addScaled(addScaled(enu.up, enu.east, 0.55), enu.north, 0.35)));
+
+    // streaming
+    this.projView.multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse);
+    this.frustum.setFromProjectionMatrix(this.projView);
+    this.streamer.update(pos, this.range, (c, radius) => {
+      this.tmpSphere.center.set(c[0] - pos[0], c[1] - pos[1], c[2] - pos[2]);
+      this.tmpSphere.radius = radius;
+      return this.frustum.intersectsSphere(this.tmpSphere);
+    });
+
+    this.renderer.render(this.scene.scene, this.camera);
+
+    const st = this.streamer.stats();
+    const settled = this.planetBusy === null && this.streamer.settled(pos, this.range);
+    this.settledFrames = settled ? this.settledFrames + 1 : 0;
+    if (this.settledFrames >= 2 && this.readyWaiters.length > 0) {
+      const waiters = this.readyWaiters;
+      this.readyWaiters = [];
+      for (const w of waiters) {
+        clearTimeout(w.timer);
+        w.resolve();
+      }
+    }
+    if (now - this.lastUiUpdate > 200) {
+      this.lastUiUpdate = now;
+      this.ui.setStats({
+        planet: `${this.choice.preset ?? '?'} · seed ${this.choice.seed ?? '?'}`,
+        chunks: st.loaded,
+        pending: st.pending,
+        triangles: st.triangles,
+        fps: this.fps,
+        lat: this.state.lat,
+        lon: this.state.lon,
+        alt: this.state.alt,
+        aboveGround: this.aboveGround,
+        heading: this.state.heading,
+      });
+      this.ui.setLoading(st.pending, st.missing, this.planetBusy);
+    }
+    if (moved) this.writeHash(false);
+  }
+
+  // ---- errors and the test hook -------------------------------------------------------------
+
+  private showError(message: string): void {
+    this.error = message;
+    this.ui.showError(message);
+  }
+
+  private clearError(): void {
+    this.error = null;
+    this.ui.clearError();
+  }
+
+  stats(): PmcStats {
+    const st = this.streamer.stats();
+    return {
+      preset: this.choice.preset ?? null,
+      seed: this.choice.seed ?? null,
+      loaded: st.loaded,
+      pending: st.pending,
+      missing: st.missing,
+      triangles: st.triangles,
+      vertices: st.vertices,
+      requested: st.requested,
+      failed: st.failed,
+      fps: this.fps,
+      frames: this.frames,
+      lat: this.state.lat,
+      lon: this.state.lon,
+      alt: this.state.alt,
+      heading: this.state.heading,
+      pitch: this.state.pitch,
+      aboveGround: this.aboveGround,
+      mode: this.mode,
+      walk: this.walk,
+      range: this.range,
+      drawCalls: this.renderer.info.render.calls,
+      ready: this.settledFrames >= 2,
+      error: this.error,
+      loadedKeys: this.streamer.loadedKeys(),
+    };
+  }
+
+  private testHook(): PmcTestHook {
+    return {
+      stats: () => this.stats(),
+      ready: (timeoutMs = 120_000) =>
+        new Promise<void>((resolve, reject) => {
+          this.settledFrames = Math.min(this.settledFrames, 1);
+          const timer = window.setTimeout(() => {
+            this.readyWaiters = this.readyWaiters.filter((w) => w.timer !== timer);
+            const s = this.stats();
+            reject(
+              new Error(
+                `__pmc.ready() timed out after ${timeoutMs} ms (loaded ${s.loaded}, pending ${s.pending}, ` +
+                  `missing ${s.missing}, error ${String(s.error)})`,
+              ),
+            );
+          }, timeoutMs);
+          this.readyWaiters.push({ resolve, reject, timer });
+        }),
+      setCamera: (lat, lon, alt, heading, pitch) => this.setCamera(lat, lon, alt, heading, pitch),
+      setPlanet: (preset, seed) => this.setPlanet(preset, String(seed)),
+      mode: (name) => {
+        if (name === 'walk') this.setWalk(true);
+        else if (name === 'fly') {
+          this.setMode('fly');
+          this.setWalk(false);
+        } else if (name === 'orbit') this.setMode('orbit');
+        return this.walk ? 'walk' : this.mode;
+      },
+      debug: (flags) => {
+        this.scene.setDebug(flags);
+        this.ui.setDebug(this.scene.debug());
+        return this.scene.debug();
+      },
+    };
+  }
+}

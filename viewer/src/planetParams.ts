@@ -1,0 +1,58 @@
+// Numbers the viewer derives from `/api/v1/planet`: the datum that altitudes and heights refer
+// to, the radial extent of the surface, and the shading parameters. Pure.
+
+import type { PlanetInfo, Vec3Tuple } from './api';
+import type { PlanetShape } from './cameraModel';
+import type { PlanetExtent } from './chunkSelection';
+import { NOISE_PERIOD_CELLS } from './shaders';
+
+export interface PlanetParams {
+  shape: PlanetShape;
+  extent: PlanetExtent;
+  seaRadius: number | null;
+  /** Metres from the datum to the highest terrain (scale of the height bands). */
+  bandHeight: number;
+  /** Metres above the datum where snow starts. */
+  snowHeight: number;
+  snowAmount: number;
+  /** Metres of water that absorb most light. */
+  waterScale: number;
+  /** Noise frequency, cycles per metre, and its period in metres. */
+  noiseFreq: number;
+  noisePeriod: number;
+  /** Palette colours scaled to a mean luminance of 1 (multiplied into the vertex colour). */
+  paletteA: Vec3Tuple;
+  paletteB: Vec3Tuple;
+  /** Width of a chunk at the surface, metres. */
+  chunkWidth: number;
+}
+
+const luminance = (c: Vec3Tuple): number => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+
+export function planetParams(p: PlanetInfo): PlanetParams {
+  const sea = p.sea_radius;
+  const datum = sea ?? (p.base_radius + p.radius) / 2;
+  const bounds = p.surface_bounds ?? [p.base_radius, p.radius];
+  const outer = Math.max(bounds[1], datum);
+  const lowest = bounds[0];
+  const inner = Math.max(lowest, sea ?? -Infinity);
+  const bandHeight = Math.max(1, outer - datum);
+  const chunkWidth = ((Math.PI / 2) * datum) / Math.max(1, p.layout.n_c);
+  const noiseFreq = 2 / Math.max(1, chunkWidth);
+  const mean = Math.max(1e-3, (luminance(p.palette.a) + luminance(p.palette.b)) / 2);
+  const norm = (c: Vec3Tuple): Vec3Tuple => [c[0] / mean, c[1] / mean, c[2] / mean];
+  return {
+    shape: { datum, outer, inner: lowest },
+    extent: { innerRadius: inner, outerRadius: outer },
+    seaRadius: sea,
+    bandHeight,
+    snowHeight: 0.6 * bandHeight,
+    snowAmount: sea !== null ? 1 : 0.3,
+    waterScale: sea !== null ? Math.max(2, (sea - lowest) / 3) : 1,
+    noiseFreq,
+    noisePeriod: NOISE_PERIOD_CELLS / noiseFreq,
+    paletteA: norm(p.palette.a),
+    paletteB: norm(p.palette.b),
+    chunkWidth,
+  };
+}

@@ -1,0 +1,173 @@
+// The DOM panels of index.html: stats, planet picker, mode switch, debug toggles, loading
+// indicator and error banner. Plain DOM, no framework.
+
+import type { CameraMode } from './cameraModel';
+import type { PresetInfo } from './api';
+import type { DebugFlags } from './planetScene';
+
+export interface UiCallbacks {
+  onPlanet(preset: string, seed: string): void;
+  onMode(mode: CameraMode): void;
+  onWalk(walk: boolean): void;
+  onDebug(flags: Partial<DebugFlags>): void;
+}
+
+export interface StatsView {
+  planet: string;
+  chunks: number;
+  pending: number;
+  triangles: number;
+  fps: number;
+  lat: number;
+  lon: number;
+  alt: number;
+  aboveGround: number | null;
+  heading: number;
+}
+
+function byId<T extends HTMLElement>(id: string): T {
+  const el = document.getElementById(id);
+  if (!el) throw new Error(`index.html lacks #${id}`);
+  return el as T;
+}
+
+const fmtInt = (n: number): string => Math.round(n).toLocaleString('en-US');
+
+export function formatDistance(m: number): string {
+  const a = Math.abs(m);
+  if (a >= 100_000) return `${(m / 1000).toFixed(0)} km`;
+  if (a >= 10_000) return `${(m / 1000).toFixed(1)} km`;
+  if (a >= 1000) return `${(m / 1000).toFixed(2)} km`;
+  return `${m.toFixed(1)} m`;
+}
+
+export class Ui {
+  private readonly preset = byId<HTMLSelectElement>('preset');
+  private readonly seed = byId<HTMLInputElement>('seed');
+  private readonly modeButton = byId<HTMLButtonElement>('mode');
+  private readonly walk = byId<HTMLInputElement>('walk');
+  private readonly wireframe = byId<HTMLInputElement>('wireframe');
+  private readonly faces = byId<HTMLInputElement>('faces');
+  private readonly borders = byId<HTMLInputElement>('borders');
+  private readonly loading = byId<HTMLDivElement>('loading');
+  private readonly loadingText = byId<HTMLSpanElement>('loading-text');
+  private readonly error = byId<HTMLDivElement>('error');
+  private readonly errorText = byId<HTMLSpanElement>('error-text');
+  private readonly fields = {
+    planet: byId('s-planet'),
+    chunks: byId('s-chunks'),
+    pending: byId('s-pending'),
+    triangles: byId('s-triangles'),
+    fps: byId('s-fps'),
+    lat: byId('s-lat'),
+    lon: byId('s-lon'),
+    alt: byId('s-alt'),
+    ground: byId('s-ground'),
+    heading: byId('s-heading'),
+  };
+  private mode: CameraMode = 'orbit';
+
+  constructor(private readonly callbacks: UiCallbacks) {
+    byId<HTMLFormElement>('planet-form').addEventListener('submit', (e) => {
+      e.preventDefault();
+      this.submitPlanet();
+    });
+    // choosing another preset regenerates at once
+    this.preset.addEventListener('change', () => this.submitPlanet());
+    this.modeButton.addEventListener('click', () => {
+      this.callbacks.onMode(this.mode === 'orbit' ? 'fly' : 'orbit');
+    });
+    this.walk.addEventListener('change', () => this.callbacks.onWalk(this.walk.checked));
+    this.wireframe.addEventListener('change', () =>
+      this.callbacks.onDebug({ wireframe: this.wireframe.checked }),
+    );
+    this.faces.addEventListener('change', () =>
+      this.callbacks.onDebug({ faceColours: this.faces.checked }),
+    );
+    this.borders.addEventListener('change', () =>
+      this.callbacks.onDebug({ borders: this.borders.checked }),
+    );
+    byId('error-close').addEventListener('click', () => this.clearError());
+  }
+
+  private submitPlanet(): void {
+    const seed = this.seed.value.trim();
+    if (!/^\d{1,20}$/.test(seed) || BigInt(seed) > 18446744073709551615n) {
+      this.showError(`the seed must be a whole number from 0 to 18446744073709551615, not "${seed}"`);
+      return;
+    }
+    this.callbacks.onPlanet(this.preset.value, seed);
+  }
+
+  setPresets(presets: PresetInfo[], current: string): void {
+    const names = presets.map((p) => p.name).join('\n');
+    if (this.preset.dataset['names'] !== names) {
+      this.preset.replaceChildren(
+        ...presets.map((p) => {
+          const o = document.createElement('option');
+          o.value = p.name;
+          o.textContent = p.name;
+          o.title = p.description;
+          return o;
+        }),
+      );
+      this.preset.dataset['names'] = names;
+    }
+    this.preset.value = current;
+  }
+
+  setPlanet(preset: string, seed: string): void {
+    this.preset.value = preset;
+    this.seed.value = seed;
+  }
+
+  setMode(mode: CameraMode, walk: boolean): void {
+    this.mode = mode;
+    this.modeButton.textContent = `Mode: ${mode}`;
+    this.walk.checked = walk;
+    this.walk.disabled = mode !== 'fly';
+  }
+
+  setDebug(flags: DebugFlags): void {
+    this.wireframe.checked = flags.wireframe;
+    this.faces.checked = flags.faceColours;
+    this.borders.checked = flags.borders;
+  }
+
+  setLoading(pending: number, missing: number, busyText: string | null): void {
+    const show = busyText !== null || pending > 0;
+    this.loading.hidden = !show;
+    if (show) {
+      this.loadingText.textContent =
+        busyText ?? `loading ${pending + missing} chunk${pending + missing === 1 ? '' : 's'}`;
+    }
+  }
+
+  showError(message: string): void {
+    this.errorText.textContent = message;
+    this.error.hidden = false;
+  }
+
+  clearError(): void {
+    this.error.hidden = true;
+    this.errorText.textContent = '';
+  }
+
+  errorMessage(): string | null {
+    return this.error.hidden ? null : this.errorText.textContent;
+  }
+
+  setStats(s: StatsView): void {
+    const f = this.fields;
+    f.planet.textContent = s.planet;
+    f.chunks.textContent = fmtInt(s.chunks);
+    f.pending.textContent = fmtInt(s.pending);
+    f.triangles.textContent = fmtInt(s.triangles);
+    f.fps.textContent = s.fps.toFixed(0);
+    f.lat.textContent = `${Math.abs(s.lat).toFixed(4)}° ${s.lat >= 0 ? 'N' : 'S'}`;
+    f.lon.textContent = `${Math.abs(s.lon).toFixed(4)}° ${s.lon >= 0 ? 'E' : 'W'}`;
+    f.alt.textContent = formatDistance(s.alt);
+    f.ground.textContent = s.aboveGround === null ? '–' : formatDistance(s.aboveGround);
+    f.heading.textContent = `${s.heading.toFixed(0)}°`;
+  }
+}

@@ -1,0 +1,59 @@
+// The viewer's state in the URL hash, e.g.
+// `#preset=earthlike&seed=7&mode=orbit&lat=12.5&lon=-40&alt=3000&heading=0&pitch=-90`.
+// Pure: parse and format only.
+
+import type { CameraMode } from './cameraModel';
+
+export interface UrlState {
+  preset?: string;
+  seed?: string;
+  mode?: CameraMode;
+  walk?: boolean;
+  lat?: number;
+  lon?: number;
+  alt?: number;
+  heading?: number;
+  pitch?: number;
+}
+
+const NUMBER_KEYS = ['lat', 'lon', 'alt', 'heading', 'pitch'] as const;
+
+export function parseHash(hash: string): UrlState {
+  const params = new URLSearchParams(hash.startsWith('#') ? hash.slice(1) : hash);
+  const out: UrlState = {};
+  const preset = params.get('preset');
+  if (preset && /^[a-z0-9_-]{1,32}$/i.test(preset)) out.preset = preset;
+  const seed = params.get('seed');
+  if (seed !== null && /^\d{1,20}$/.test(seed)) out.seed = seed;
+  const mode = params.get('mode');
+  if (mode === 'orbit' || mode === 'fly') out.mode = mode;
+  const walk = params.get('walk');
+  if (walk !== null) out.walk = walk === '1' || walk === 'true';
+  for (const k of NUMBER_KEYS) {
+    const v = params.get(k);
+    if (v === null || v.trim() === '') continue;
+    const n = Number(v);
+    if (Number.isFinite(n)) out[k] = n;
+  }
+  if (out.lat !== undefined) out.lat = Math.max(-90, Math.min(90, out.lat));
+  return out;
+}
+
+/** Rounds to `digits` decimals without trailing zeros. */
+function fmt(n: number, digits: number): string {
+  return String(Number(n.toFixed(digits)));
+}
+
+export function formatHash(s: UrlState): string {
+  const params = new URLSearchParams();
+  if (s.preset) params.set('preset', s.preset);
+  if (s.seed !== undefined) params.set('seed', s.seed);
+  if (s.mode) params.set('mode', s.mode);
+  if (s.walk) params.set('walk', '1');
+  if (s.lat !== undefined) params.set('lat', fmt(s.lat, 5));
+  if (s.lon !== undefined) params.set('lon', fmt(s.lon, 5));
+  if (s.alt !== undefined) params.set('alt', fmt(s.alt, 1));
+  if (s.heading !== undefined) params.set('heading', fmt(s.heading, 1));
+  if (s.pitch !== undefined) params.set('pitch', fmt(s.pitch, 1));
+  return `#${params.toString()}`;
+}

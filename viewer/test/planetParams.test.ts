@@ -1,0 +1,38 @@
+import { describe, expect, it } from 'vitest';
+import type { PlanetInfo } from '../src/api';
+import { planetParams } from '../src/planetParams';
+
+const base: PlanetInfo = {
+  format: 'pmc-planet', version: 1, preset: 'earthlike', seed: '7', presets: [],
+  layout: { n_c: 8, n_t: 32, d_b: 1744, l_d: 4, d_c: 2 },
+  radius: 2000, base_radius: 1744, sea_radius: 1884.8, surface_bounds: [1810.6, 1995.5],
+  chunk_count: 768, face_tiles: 256, depth_tiles: 64, faces: [], materials: [],
+  palette: { a: [0.8, 0.7, 0.5], b: [0.3, 0.5, 0.2] },
+};
+
+describe('planetParams', () => {
+  it('measures altitude from sea level and streams above the sea floor that the sea hides', () => {
+    const p = planetParams(base);
+    expect(p.shape).toEqual({ datum: 1884.8, outer: 1995.5, inner: 1810.6 });
+    expect(p.extent).toEqual({ innerRadius: 1884.8, outerRadius: 1995.5 });
+    expect(p.bandHeight).toBeCloseTo(110.7, 9);
+    expect(p.snowHeight).toBeGreaterThan(0);
+    expect(p.snowHeight).toBeLessThan(p.bandHeight);
+    expect(p.waterScale).toBeCloseTo((1884.8 - 1810.6) / 3, 9);
+    expect(p.noisePeriod * p.noiseFreq).toBeCloseTo(289, 9);
+  });
+
+  it('uses the middle of the shell without a sea and the shell without surface bounds', () => {
+    const p = planetParams({ ...base, sea_radius: null, surface_bounds: null });
+    expect(p.shape.datum).toBe(1872);
+    expect(p.extent).toEqual({ innerRadius: 1744, outerRadius: 2000 });
+    expect(p.seaRadius).toBeNull();
+    expect(p.snowAmount).toBeLessThan(1);
+  });
+
+  it('normalises the palette to a mean luminance of 1', () => {
+    const p = planetParams(base);
+    const lum = (c: number[]): number => 0.2126 * c[0]! + 0.7152 * c[1]! + 0.0722 * c[2]!;
+    expect((lum(p.paletteA) + lum(p.paletteB)) / 2).toBeCloseTo(1, 9);
+  });
+});
