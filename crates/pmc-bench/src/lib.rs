@@ -2,7 +2,9 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-use pmc_geometry::{ChunkGrid, ChunkKey, Layout};
+use pmc_density::Density;
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::{sphere_to_face_uv, ChunkGrid, ChunkKey, LatLon, Layout};
 use pmc_mesh::{close_shell, ChunkMesh, Mesher};
 use pmc_planet::{Planet, PresetKind};
 
@@ -43,4 +45,43 @@ pub fn triangle_count(grid: &ChunkGrid, d: &[f32]) -> usize {
     let mut m = ChunkMesh::default();
     Mesher::new().mesh(grid, d, &mut m);
     m.triangle_count()
+}
+
+/// The terrain surface of `planet` above latitude `lat`, longitude `lon` (degrees); see
+/// [`surface_along`].
+pub fn surface_point(planet: &Planet, lat: f64, lon: f64) -> DVec3 {
+    let dir = LatLon::new(lat, lon).expect("a valid latitude and longitude").to_unit();
+    surface_along(planet, dir)
+}
+
+/// The terrain surface of `planet` along the unit direction `dir`: the outermost zero crossing of
+/// the density on the radial line, searched down from the top of the shell in quarter-voxel steps
+/// and refined by bisection. The point returned is on the solid side, within 1e-9 m.
+pub fn surface_along(planet: &Planet, dir: DVec3) -> DVec3 {
+    let density = planet.density();
+    let l = planet.layout();
+    let step = 0.25 * l.l_d();
+    let mut r = l.radius();
+    while r > l.d_b() && density.density(dir * r) <= 0.0 {
+        r -= step;
+    }
+    let (mut a, mut b) = (r, r + step);
+    while b - a > 1e-9 {
+        let m = 0.5 * (a + b);
+        if density.density(dir * m) > 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    dir * a
+}
+
+/// The direction of the level-0 voxel column nearest to the direction of `p`.
+pub fn nearest_column(layout: &Layout, p: DVec3) -> DVec3 {
+    let (face, u, v) = sphere_to_face_uv(p).expect("a point away from the centre");
+    let n = layout.face_tiles();
+    let index = |x: f64| (((x + 1.0) * 0.5 * n as f64).round() as i64).clamp(0, n);
+    let l = layout.lattice(face, index(u), index(v)).expect("an index on the face");
+    layout.lattice_direction(l)
 }

@@ -41,6 +41,15 @@ pub enum CliError {
     /// The server could not start (port in use, address not available, ...) or failed.
     #[error(transparent)]
     Serve(#[from] pmc_server::ServerError),
+    /// The world file of `pmc edit` could not be used.
+    #[error(transparent)]
+    World(#[from] pmc_world::WorldError),
+    /// A brush operation was refused (centre, radius or strength).
+    #[error("{0}")]
+    Brush(#[from] pmc_edit::BrushError),
+    /// Invalid `pmc edit` options, or planet options that disagree with the world file.
+    #[error("{0}")]
+    Edit(String),
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads: {reason}")]
     Threads {
@@ -61,6 +70,8 @@ impl CliError {
             CliError::Render(pmc_render::RenderError::Io { .. } | pmc_render::RenderError::Png { .. }) => 1,
             CliError::Render(_) => 2,
             CliError::Export(_) | CliError::Threads { .. } => 1,
+            CliError::World(pmc_world::WorldError::Io { .. } | pmc_world::WorldError::Sqlite { .. }) => 1,
+            CliError::World(_) | CliError::Brush(_) | CliError::Edit(_) => 2,
         }
     }
 }

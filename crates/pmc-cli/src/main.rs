@@ -1,6 +1,7 @@
 //! `pmc`: planetary marching cubes from the command line.
 #![forbid(unsafe_code)]
 
+mod edit;
 mod error;
 mod generate;
 mod info;
@@ -30,6 +31,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Serve the web viewer and the HTTP API: chunks are generated on demand and streamed.
     Serve(serve::ServeArgs),
+    /// Dig and build: apply a brush to a planet kept in a world file, undo, redo, list edits.
+    Edit(edit::EditArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +42,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
         Command::Serve(a) => serve::run(a),
+        Command::Edit(a) => edit::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -80,19 +80,124 @@ impl BrushOp {
         if !(strength > 0.0 && strength <= 1.0) {
             return Err(BrushError::Strength(strength));
         }
-        Ok(BrushOp { kind, center, radius, strength })
+        Ok(BrushOp {
+            kind,
+            center,
+            radius,
+            strength,
+        })
     }
 
     /// Whether the brush can change anything within `r` metres of `p` (its sphere of influence,
-    /// including the margin smoothing reads, touches that ball).
+    /// [`BrushOp::reach`], touches that ball).
     pub fn touches_ball(&self, p: DVec3, r: f64) -> bool {
         (p - self.center).length() <= self.reach() + r
     }
 
-    /// Radius of the brush's influence: beyond it, density and paint are unchanged.
+    /// Radius of the brush's influence: at and beyond it, density and paint are unchanged.
+    ///
+    /// Smooth, flatten and paint act within `radius`. Add and remove carve or fill a ball of radius
+    /// `strength * radius` and then fade the density back to the terrain's over a shell of
+    /// [`BLEND_MARGIN`]` * radius` around `radius`, so the density stays continuous where the
+    /// brush stops (see [`BrushOp::apply`]).
     pub fn reach(&self) -> f64 {
-        self.radius
+        match self.kind {
+            BrushKind::Add | BrushKind::Remove => self.radius * (1.0 + BLEND_MARGIN),
+            BrushKind::Smooth | BrushKind::Flatten | BrushKind::Paint { .. } => self.radius,
+        }
     }
+
+    /// Whether the brush changes the density (every kind but paint).
+    pub fn shapes(&self) -> bool {
+        !matches!(self.kind, BrushKind::Paint { .. })
+    }
+
+    /// The radius of the ball that add fills and remove carves: `strength * radius`.
+    pub fn ball_radius(&self) -> f64 {
+        self.strength * self.radius
+    }
+
+    /// Distance between smoothing's sample points and the point they smooth: `radius / 4`.
+    pub fn smooth_step(&self) -> f64 {
+        0.25 * self.radius
+    }
+
+    /// The unit "up" of flattening: the direction of the centre from the planet centre (`+Y` for a
+    /// brush at the planet centre).
+    pub fn up(&self) -> DVec3 {
+        self.center.try_normalize().unwrap_or(DVec3::Y)
+    }
+
+    /// Applies the brush to density `d` (the density before this brush) at world point `p`, which
+    /// must lie at distance `q = |p - center| < reach()` (callers leave `d` unchanged elsewhere).
+    /// `neighbours` gives the density before this brush at another point; only smoothing calls it
+    /// (six times, at `p +- smooth_step()` along the world axes).
+    ///
+    /// With `s` the strength, `R` the radius and `w(x) = (1 - x^2)^2` (1 at the centre, 0 with zero
+    /// slope at the edge):
+    ///
+    /// - **Add**: `d' = max(d, rho - q)` with `rho = s R` (union with the ball of radius `rho`, an
+    ///   exact distance near its surface); between `R` and `reach` the change fades out by
+    ///   `w((q - R) / (reach - R))`, which only ever touches air (`rho - q < 0` there), so the solid
+    ///   is exactly the terrain's plus the open ball.
+    /// - **Remove**: `d' = min(d, q - rho)`, faded the same way: the solid is the terrain's minus
+    ///   the closed ball of radius `rho`.
+    /// - **Smooth**: `d' = d + s w(q / R) (avg - d)`, `avg` the mean of the density before this
+    ///   brush at the six points `p +- (R / 4) e_x, e_y, e_z`.
+    /// - **Flatten**: `d' = d + s w(q / R) (plane - d)`, `plane = dot(center - p, up)`, the signed
+    ///   distance to the plane through the centre perpendicular to `up`, positive below it.
+    /// - **Paint**: `d' = d`.
+    ///
+    /// Every change is continuous and vanishes at `reach`, so no seam appears where the brush
+    /// stops. Pure: the result depends on `d`, `p` and the brush only.
+    pub fn apply(&self, d: f64, p: DVec3, q: f64, mut neighbours: impl FnMut(DVec3) -> f64) -> f64 {
+        let r = self.radius;
+        match self.kind {
+            BrushKind::Add | BrushKind::Remove => {
+                let ball = self.ball_radius() - q;
+                let target = if self.kind == BrushKind::Add {
+                    d.max(ball)
+                } else {
+                    d.min(-ball)
+                };
+                if q < r {
+                    target
+                } else {
+                    let x = (q - r) / (self.reach() - r);
+                    d + falloff(x) * (target - d)
+                }
+            }
+            BrushKind::Smooth => {
+                let w = self.strength * falloff(q / r);
+                if w == 0.0 {
+                    return d;
+                }
+                let h = self.smooth_step();
+                let mut sum = 0.0;
+                for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+                    sum += neighbours(p + axis * h) + neighbours(p - axis * h);
+                }
+                d + w * (sum / 6.0 - d)
+            }
+            BrushKind::Flatten => {
+                let w = self.strength * falloff(q / r);
+                let plane = (self.center - p).dot(self.up());
+                d + w * (plane - d)
+            }
+            BrushKind::Paint { .. } => d,
+        }
+    }
+}
+
+/// How far beyond its radius an add or remove brush fades back to the terrain, as a fraction of
+/// the radius (see [`BrushOp::reach`]).
+pub const BLEND_MARGIN: f64 = 0.25;
+
+/// The brushes' weight falloff `(1 - x^2)^2` for `x` in `[0, 1]`: 1 at 0, 0 (with zero slope) at 1
+/// and beyond.
+pub fn falloff(x: f64) -> f64 {
+    let t = (1.0 - x * x).max(0.0);
+    t * t
 }
 
 #[cfg(test)]
@@ -102,10 +207,25 @@ mod tests {
     #[test]
     fn validation() {
         assert!(BrushOp::new(BrushKind::Add, DVec3::ONE, 4.0, 1.0).is_ok());
-        assert!(matches!(BrushOp::new(BrushKind::Add, DVec3::new(f64::NAN, 0.0, 0.0), 4.0, 1.0), Err(BrushError::Center(..))));
-        assert!(matches!(BrushOp::new(BrushKind::Add, DVec3::ONE, 0.0, 1.0), Err(BrushError::Radius(_))));
-        assert!(matches!(BrushOp::new(BrushKind::Add, DVec3::ONE, f64::INFINITY, 1.0), Err(BrushError::Radius(_))));
-        assert!(matches!(BrushOp::new(BrushKind::Add, DVec3::ONE, 1.0, 1.5), Err(BrushError::Strength(_))));
-        assert!(matches!(BrushOp::new(BrushKind::Add, DVec3::ONE, 1.0, f64::NAN), Err(BrushError::Strength(_))));
+        assert!(matches!(
+            BrushOp::new(BrushKind::Add, DVec3::new(f64::NAN, 0.0, 0.0), 4.0, 1.0),
+            Err(BrushError::Center(..))
+        ));
+        assert!(matches!(
+            BrushOp::new(BrushKind::Add, DVec3::ONE, 0.0, 1.0),
+            Err(BrushError::Radius(_))
+        ));
+        assert!(matches!(
+            BrushOp::new(BrushKind::Add, DVec3::ONE, f64::INFINITY, 1.0),
+            Err(BrushError::Radius(_))
+        ));
+        assert!(matches!(
+            BrushOp::new(BrushKind::Add, DVec3::ONE, 1.0, 1.5),
+            Err(BrushError::Strength(_))
+        ));
+        assert!(matches!(
+            BrushOp::new(BrushKind::Add, DVec3::ONE, 1.0, f64::NAN),
+            Err(BrushError::Strength(_))
+        ));
     }
 }

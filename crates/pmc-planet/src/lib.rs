@@ -6,6 +6,9 @@
 //! preset, seed and layout give byte-identical meshes at any thread count, because every chunk is
 //! computed from canonical voxel keys alone and results are ordered by chunk key.
 //!
+//! Edits ([`pmc_edit`] brush operations) apply through [`Planet::set_edits`]; after an edit,
+//! [`Planet::remesh`] meshes exactly the chunks it can change.
+//!
 //! ```
 //! use pmc_planet::{Planet, PresetKind};
 //! use pmc_geometry::Layout;
@@ -20,3 +23,4 @@ mod planet;
 
 pub use planet::{ChunkScratch, Planet};
 pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};
+pub use pmc_edit;

@@ -299,6 +299,12 @@ impl Shader for MarsShader {
     fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
         self.palette.shade(self.material(p, normal), p)
     }
+    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
+        self.palette.try_shade(material, p).unwrap_or(Shade {
+            color: [128, 128, 128, 255],
+            material,
+        })
+    }
 }
 
 /// Builds the Mars terrain.

@@ -92,6 +92,17 @@ pub struct Shade {
 pub trait Shader: Send + Sync {
     /// The shade at world point `p` with unit outward normal `normal`.
     fn shade(&self, p: DVec3, normal: DVec3) -> Shade;
+
+    /// The shade of material `material` (an index into [`Terrain::materials`]) at world point
+    /// `p`, whatever the terrain would put there (used to paint materials by hand). The default is
+    /// a neutral grey; the presets use their palettes. Ids past the material list get the grey.
+    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
+        let _ = p;
+        Shade {
+            color: [128, 128, 128, 255],
+            material,
+        }
+    }
 }
 
 /// A planet's terrain: density, sea and look, ready to mesh.
@@ -183,6 +194,24 @@ mod tests {
                 assert_eq!(s.color[3], 255);
             }
             assert_eq!(a.sea_radius.is_some(), kind == PresetKind::Earthlike, "{kind}");
+        }
+    }
+
+    #[test]
+    fn every_material_can_be_shaded_by_id() {
+        let layout = Layout::default();
+        let p = testing::sphere_dirs(5)[2] * layout.radius();
+        for kind in PresetKind::ALL {
+            let t = build(kind, 4, &layout);
+            let mut colors = std::collections::HashSet::new();
+            for id in 0..t.materials.len() as u8 {
+                let s = t.shader.shade_material(id, p);
+                assert_eq!((s.material, s.color[3]), (id, 255), "{kind}");
+                colors.insert(s.color);
+            }
+            assert_eq!(colors.len(), t.materials.len(), "{kind}: one colour per material");
+            let past = t.shader.shade_material(t.materials.len() as u8, p);
+            assert_eq!(past.color, [128, 128, 128, 255], "{kind}: unknown ids are grey");
         }
     }
 

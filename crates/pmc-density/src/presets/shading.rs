@@ -68,6 +68,11 @@ impl Palette {
         (0.5 + 2.5 * self.mix.sample(p * self.inv_len)).clamp(0.0, 1.0)
     }
 
+    /// The shade of material `id` at `p`, or `None` for an id past the palette.
+    pub fn try_shade(&self, id: u8, p: DVec3) -> Option<Shade> {
+        (usize::from(id) < self.materials.len()).then(|| self.shade(id, p))
+    }
+
     /// The shade of material `id` at `p`.
     pub fn shade(&self, id: u8, p: DVec3) -> Shade {
         Shade {

@@ -27,6 +27,14 @@ impl Shader for Grey {
             material: 0,
         }
     }
+    fn shade_material(&self, material: u8, _p: DVec3) -> Shade {
+        let color = if usize::from(material) < MATERIALS.len() {
+            self.0
+        } else {
+            [128, 128, 128, 255]
+        };
+        Shade { color, material }
+    }
 }
 
 /// Builds the sphere terrain.

@@ -1,0 +1,537 @@
+//! Edited planets: brushes keep the planet one closed surface, chunks keep agreeing on shared
+//! voxels, undo gives back the exact meshes, and remeshing the affected chunks is enough.
+
+use pmc_density::Density;
+use pmc_edit::{affected_chunks, BrushKind, BrushOp, EditLog, EditSnapshot};
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::{face_uv_to_sphere, ChunkGrid, ChunkKey, Face, Layout, VoxelKey};
+use pmc_mesh::{ChunkMesh, WeldedMesh};
+use pmc_planet::{Planet, PresetKind};
+use proptest::prelude::*;
+use std::collections::{BTreeMap, HashMap};
+
+/// The small layout of the property tests: `n_c = 2`, `n_t = 8`, a 16 m shell at radius 60-76 m.
+fn small_layout() -> Layout {
+    Layout::new(2, 8, 60.0, 1.0, 2).unwrap()
+}
+
+/// Every chunk's mesh (empty ones included), by key.
+fn all_meshes(planet: &Planet) -> BTreeMap<ChunkKey, ChunkMesh> {
+    planet
+        .layout()
+        .chunks(0)
+        .into_iter()
+        .map(|k| (k, planet.chunk_mesh(k)))
+        .collect()
+}
+
+/// Every byte of a mesh that anything downstream reads.
+fn bytes(m: &ChunkMesh) -> Vec<u8> {
+    let mut b = Vec::new();
+    b.extend(format!("{:?}", m.key).bytes());
+    for x in m.origin.to_array() {
+        b.extend(x.to_bits().to_le_bytes());
+    }
+    for v in m.positions.iter().chain(&m.normals) {
+        for x in v {
+            b.extend(x.to_bits().to_le_bytes());
+        }
+    }
+    for i in &m.indices {
+        b.extend(i.to_le_bytes());
+    }
+    for k in &m.edge_keys {
+        b.extend(k.0.to_le_bytes());
+        b.extend(k.1.to_le_bytes());
+    }
+    for x in m.heights.iter().chain(&m.water_depths) {
+        b.extend(x.to_bits().to_le_bytes());
+    }
+    for c in &m.colors {
+        b.extend(c);
+    }
+    b.extend(&m.materials);
+    b
+}
+
+fn same(a: &BTreeMap<ChunkKey, ChunkMesh>, b: &BTreeMap<ChunkKey, ChunkMesh>) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|((ka, ma), (kb, mb))| ka == kb && bytes(ma) == bytes(mb))
+}
+
+fn report(meshes: &BTreeMap<ChunkKey, ChunkMesh>) -> pmc_mesh::ManifoldReport {
+    let list: Vec<ChunkMesh> = meshes.values().filter(|m| !m.is_empty()).cloned().collect();
+    WeldedMesh::weld(&list).report()
+}
+
+fn assert_closed(meshes: &BTreeMap<ChunkKey, ChunkMesh>) {
+    let r = report(meshes);
+    assert!(r.triangles > 0);
+    assert!(r.is_closed_manifold(), "not a closed manifold: {r:?}");
+}
+
+/// Samples every chunk's padded grid through the planet's (edited) density and checks that every
+/// voxel held by several chunks (borders, face edges, cube corners, valid padding) got the same
+/// bits from each. Returns the number of repeated readings compared.
+fn shared_voxels_agree(planet: &Planet) -> usize {
+    let mut seen: HashMap<VoxelKey, (u32, ChunkKey)> = HashMap::new();
+    let mut compared = 0;
+    for key in planet.layout().chunks(0) {
+        let g = ChunkGrid::new(planet.layout(), key);
+        let mut d = vec![0.0f32; g.sample_count()];
+        planet.density().sample_shell(&g.dirs, &g.radii, &mut d);
+        for c in 0..g.padded {
+            for b in 0..g.padded {
+                for a in 0..g.padded {
+                    if !g.valid[b * g.padded + a] {
+                        continue;
+                    }
+                    let bits = d[g.index(a, b, c)].to_bits();
+                    let vk = g.voxel_key(a, b, c);
+                    if let Some((prev, owner)) = seen.insert(vk, (bits, key)) {
+                        compared += 1;
+                        assert_eq!(
+                            prev,
+                            bits,
+                            "voxel {vk:?}: {} in {owner}, {} in {key}",
+                            f32::from_bits(prev),
+                            f32::from_bits(bits)
+                        );
+                    }
+                }
+            }
+        }
+    }
+    compared
+}
+
+/// The radius of the surface along `dir` (the outermost zero crossing, by bisection).
+fn surface_radius(density: &dyn Density, dir: DVec3, lo: f64, hi: f64) -> f64 {
+    let step = 0.25;
+    let mut r = hi;
+    while r > lo && density.density(dir * r) <= 0.0 {
+        r -= step;
+    }
+    let (mut a, mut b) = (r, r + step);
+    for _ in 0..60 {
+        let m = 0.5 * (a + b);
+        if density.density(dir * m) > 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    a
+}
+
+/// Where a random brush goes: anywhere on a face, on a face edge, or on a cube corner.
+#[derive(Clone, Copy, Debug)]
+enum Place {
+    Face(usize, f64, f64),
+    Edge(usize, bool, bool, f64),
+    Corner(usize, bool, bool),
+}
+
+impl Place {
+    fn dir(self) -> DVec3 {
+        let pm = |b: bool| if b { 1.0 } else { -1.0 };
+        match self {
+            Place::Face(f, u, v) => face_uv_to_sphere(Face::ALL[f], u, v),
+            Place::Edge(f, along_u, side, t) => {
+                let (u, v) = if along_u { (t, pm(side)) } else { (pm(side), t) };
+                face_uv_to_sphere(Face::ALL[f], u, v)
+            }
+            Place::Corner(f, a, b) => face_uv_to_sphere(Face::ALL[f], pm(a), pm(b)),
+        }
+        .normalize()
+    }
+}
+
+fn place() -> impl Strategy<Value = Place> {
+    prop_oneof![
+        (0usize..6, -1.0f64..1.0, -1.0f64..1.0).prop_map(|(f, u, v)| Place::Face(f, u, v)),
+        (0usize..6, any::<bool>(), any::<bool>(), -1.0f64..1.0).prop_map(|(f, a, s, t)| Place::Edge(f, a, s, t)),
+        (0usize..6, any::<bool>(), any::<bool>()).prop_map(|(f, a, b)| Place::Corner(f, a, b)),
+    ]
+}
+
+/// A random brush: kind, place, height offset from the surface, radius, strength.
+#[derive(Clone, Copy, Debug)]
+struct RandomOp {
+    kind: usize,
+    place: Place,
+    offset: f64,
+    radius: f64,
+    strength: f64,
+}
+
+fn random_op() -> impl Strategy<Value = RandomOp> {
+    (0usize..5, place(), -3.0f64..3.0, 1.0f64..30.0, 0.2f64..1.0).prop_map(|(kind, place, offset, radius, strength)| {
+        RandomOp {
+            kind,
+            place,
+            offset,
+            radius,
+            strength,
+        }
+    })
+}
+
+impl RandomOp {
+    /// The brush, centred `offset` metres off the current surface. Smoothing reads the density
+    /// six times per sample (recursively under earlier smoothing), so its radius stays small.
+    fn resolve(self, planet: &Planet) -> BrushOp {
+        let kind = [
+            BrushKind::Add,
+            BrushKind::Remove,
+            BrushKind::Smooth,
+            BrushKind::Flatten,
+            BrushKind::Paint { material: 2 },
+        ][self.kind];
+        let radius = if kind == BrushKind::Smooth {
+            1.0 + (self.radius - 1.0) * 7.0 / 29.0
+        } else {
+            self.radius
+        };
+        let l = planet.layout();
+        let dir = self.place.dir();
+        let r = surface_radius(planet.density().as_ref(), dir, l.d_b(), l.radius());
+        BrushOp::new(kind, dir * (r + self.offset), radius, self.strength).unwrap()
+    }
+}
+
+fn preset(sphere: bool) -> PresetKind {
+    if sphere {
+        PresetKind::Sphere
+    } else {
+        PresetKind::Earthlike
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Random sequences of all five brushes, anywhere near the surface (face edges and cube
+    /// corners included): after every edit, replacing the affected chunks' meshes gives exactly
+    /// a fresh planet's meshes, and the union is a closed 2-manifold; after the sequence, chunks
+    /// agree bit for bit on every shared voxel.
+    #[test]
+    fn random_edit_sequences_keep_the_planet_closed_and_paired(
+        sphere in any::<bool>(),
+        seed in 0u64..1000,
+        ops in proptest::collection::vec(random_op(), 1..6),
+    ) {
+        let mut planet = Planet::new(preset(sphere), seed, small_layout());
+        let mut log = EditLog::new();
+        let mut meshes = all_meshes(&planet);
+        for r in ops {
+            let op = r.resolve(&planet);
+            log.push(op);
+            planet.set_edits(log.snapshot());
+            let remeshed = planet.remesh(&op);
+            let reused = planet.remesh_reusing(&op, |k| meshes.get(k));
+            prop_assert_eq!(remeshed.len(), reused.len());
+            for (a, b) in remeshed.iter().zip(&reused) {
+                prop_assert!(bytes(a) == bytes(b), "reusing the shading changed {:?}", a.key);
+            }
+            for m in remeshed {
+                meshes.insert(m.key.unwrap(), m);
+            }
+            let fresh = all_meshes(&planet);
+            prop_assert!(same(&meshes, &fresh), "remeshing the affected chunks missed a change after {op:?}");
+            let rep = report(&meshes);
+            prop_assert!(rep.is_closed_manifold(), "after {op:?}: {rep:?}");
+        }
+        prop_assert!(shared_voxels_agree(&planet) > 1000);
+        // The parallel generator agrees with the chunk-by-chunk meshes.
+        let generated = planet.generate(|_| {});
+        let nonempty: Vec<&ChunkMesh> = meshes.values().filter(|m| !m.is_empty()).collect();
+        prop_assert_eq!(generated.len(), nonempty.len());
+        for (g, m) in generated.iter().zip(nonempty) {
+            prop_assert!(bytes(g) == bytes(m));
+        }
+    }
+
+    /// Soundness of `affected_chunks`: on a planet already carrying edits, every chunk whose mesh
+    /// changes when one more random brush is applied is listed.
+    #[test]
+    fn every_chunk_whose_mesh_changes_is_affected(
+        sphere in any::<bool>(),
+        before in proptest::collection::vec(random_op(), 0..3),
+        op in random_op(),
+    ) {
+        let mut planet = Planet::new(preset(sphere), 7, small_layout());
+        let mut log = EditLog::new();
+        for r in before {
+            log.push(r.resolve(&planet));
+            planet.set_edits(log.snapshot());
+        }
+        let old = all_meshes(&planet);
+        let op = op.resolve(&planet);
+        log.push(op);
+        planet.set_edits(log.snapshot());
+        let new = all_meshes(&planet);
+        let listed = affected_chunks(planet.layout(), &op);
+        let mut changed = 0;
+        for (key, m) in &new {
+            if bytes(m) != bytes(&old[key]) {
+                changed += 1;
+                prop_assert!(listed.contains(key), "{key} changed but is not listed for {op:?}");
+            }
+        }
+        prop_assert!(listed.len() <= changed + 16 || listed.len() <= 2 * changed + 4, "{} listed, {changed} changed", listed.len());
+    }
+}
+
+/// A surface point of `planet` above `dir`, and the planet with one brush there.
+fn brush_at(planet: &Planet, kind: BrushKind, dir: DVec3, radius: f64) -> BrushOp {
+    let l = planet.layout();
+    let r = surface_radius(planet.density().as_ref(), dir.normalize(), l.d_b(), l.radius());
+    BrushOp::new(kind, dir.normalize() * r, radius, 1.0).unwrap()
+}
+
+#[test]
+fn undo_gives_back_the_exact_meshes_and_redo_the_edited_ones() {
+    let mut planet = Planet::new(PresetKind::Earthlike, 3, small_layout());
+    let original = all_meshes(&planet);
+    let mut log = EditLog::new();
+    let dig = brush_at(&planet, BrushKind::Remove, DVec3::new(0.3, 1.0, 0.2), 9.0);
+    log.push(dig);
+    planet.set_edits(log.snapshot());
+    let edited = all_meshes(&planet);
+    assert!(!same(&original, &edited), "the edit changes the planet");
+
+    assert_eq!(log.undo(), Some(dig));
+    planet.set_edits(log.snapshot());
+    assert!(
+        same(&all_meshes(&planet), &original),
+        "undo restores the meshes byte for byte"
+    );
+    // Remeshing after the undo, with or without the edited meshes' shading, gives them too.
+    let undone = planet.remesh(&dig);
+    assert!(!undone.is_empty());
+    for (m, r) in undone.iter().zip(planet.remesh_reusing(&dig, |k| edited.get(k))) {
+        assert_eq!(bytes(m), bytes(&original[&m.key.unwrap()]));
+        assert_eq!(bytes(m), bytes(&r));
+    }
+
+    assert_eq!(log.redo(), Some(dig));
+    planet.set_edits(log.snapshot());
+    assert!(same(&all_meshes(&planet), &edited), "redo restores the edited meshes");
+
+    // Pushing after an undo drops the redo tail.
+    log.undo();
+    let fill = brush_at(&planet, BrushKind::Add, DVec3::new(-0.5, 0.2, 1.0), 6.0);
+    log.push(fill);
+    assert_eq!(log.redo(), None);
+    assert_eq!(log.active(), &[fill]);
+    planet.set_edits(log.snapshot());
+    let filled = all_meshes(&planet);
+    assert!(!same(&filled, &original) && !same(&filled, &edited));
+    // And undoing that one gives the original planet back again.
+    log.undo();
+    planet.set_edits(log.snapshot());
+    assert!(same(&all_meshes(&planet), &original));
+    assert_eq!(
+        planet.density().radial_bounds(),
+        planet.terrain().density.radial_bounds()
+    );
+}
+
+#[test]
+fn dig_then_look_a_remove_at_the_surface_opens_a_pit() {
+    // A sphere with 1 m layers and about 5 m columns: a 10 m ball carved at its surface.
+    let layout = Layout::new(2, 16, 100.0, 1.0, 1).unwrap();
+    let mut planet = Planet::new(PresetKind::Sphere, 1, layout);
+    let (r, _) = planet.terrain().density.radial_bounds().unwrap();
+    let before = all_meshes(&planet);
+    assert_closed(&before);
+    let dir = DVec3::new(0.2, 0.3, 1.0).normalize();
+    let op = BrushOp::new(BrushKind::Remove, dir * r, 10.0, 1.0).unwrap();
+    planet.set_edits(vec![op].into());
+    assert!(
+        (planet.density().density(op.center) + 10.0).abs() < 1e-9,
+        "air at the centre"
+    );
+    let after = all_meshes(&planet);
+    assert_closed(&after);
+    let deepest = |m: &BTreeMap<ChunkKey, ChunkMesh>| {
+        m.values()
+            .flat_map(|c| (0..c.vertex_count()).map(move |i| c.world_position(i)))
+            .filter(|p| (*p - op.center).length() < 12.0)
+            .map(|p| p.length())
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(deepest(&before) > r - 0.5, "no pit before: {}", deepest(&before));
+    assert!(deepest(&after) < r - 8.0, "a pit about 10 m deep: {}", deepest(&after));
+    // The volume lost is about half the ball (the surface curves away a little).
+    let volume = |m: &BTreeMap<ChunkKey, ChunkMesh>| {
+        WeldedMesh::weld(&m.values().filter(|c| !c.is_empty()).cloned().collect::<Vec<_>>()).volume()
+    };
+    let lost = volume(&before) - volume(&after);
+    let half_ball = 2.0 / 3.0 * std::f64::consts::PI * 1000.0;
+    assert!(
+        lost > 0.7 * half_ball && lost < 1.2 * half_ball,
+        "lost {lost} m^3, half ball {half_ball}"
+    );
+    // Everything changed lies in the affected chunks, and only a few chunks are.
+    let listed = affected_chunks(&layout, &op);
+    for (k, m) in &after {
+        if bytes(m) != bytes(&before[k]) {
+            assert!(listed.contains(k), "{k}");
+        }
+    }
+    assert!(listed.len() <= 8, "{listed:?}");
+}
+
+/// The eight cube corners, each named once (three faces meet at each).
+fn cube_corners() -> Vec<DVec3> {
+    let mut out: Vec<DVec3> = Vec::new();
+    for face in Face::ALL {
+        for (u, v) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+            let d = face_uv_to_sphere(face, u, v);
+            if !out.iter().any(|o| (*o - d).length() < 1e-9) {
+                out.push(d);
+            }
+        }
+    }
+    assert_eq!(out.len(), 8);
+    out
+}
+
+#[test]
+fn remove_at_a_cube_corner_keeps_the_planet_closed() {
+    for (i, corner) in cube_corners().into_iter().enumerate() {
+        for preset in [PresetKind::Earthlike, PresetKind::Sphere] {
+            let mut planet = Planet::new(preset, 11 + i as u64, small_layout());
+            let before = all_meshes(&planet);
+            let op = brush_at(&planet, BrushKind::Remove, corner, 6.0);
+            planet.set_edits(vec![op].into());
+            let after = all_meshes(&planet);
+            assert_closed(&after);
+            assert!(shared_voxels_agree(&planet) > 1000);
+            // The pit reaches the three faces that meet there.
+            let mut faces: Vec<Face> = after
+                .iter()
+                .filter(|(k, m)| bytes(m) != bytes(&before[k]))
+                .map(|(k, _)| k.face)
+                .collect();
+            faces.dedup();
+            faces.sort_by_key(|f| f.index());
+            faces.dedup();
+            assert_eq!(faces.len(), 3, "{preset} corner {i}: changed faces {faces:?}");
+        }
+    }
+}
+
+#[test]
+fn remove_across_a_face_edge_keeps_the_planet_closed() {
+    for face in Face::ALL {
+        for (u, v) in [(1.0, 0.3), (-0.4, -1.0)] {
+            let mut planet = Planet::new(PresetKind::Earthlike, 5, small_layout());
+            let before = all_meshes(&planet);
+            let op = brush_at(&planet, BrushKind::Remove, face_uv_to_sphere(face, u, v), 12.0);
+            planet.set_edits(vec![op].into());
+            let after = all_meshes(&planet);
+            assert_closed(&after);
+            assert!(shared_voxels_agree(&planet) > 1000);
+            let faces: std::collections::BTreeSet<usize> = after
+                .iter()
+                .filter(|(k, m)| bytes(m) != bytes(&before[k]))
+                .map(|(k, _)| k.face.index())
+                .collect();
+            assert!(
+                faces.len() >= 2,
+                "{face} ({u}, {v}): the edit crosses the edge, changed {faces:?}"
+            );
+            assert!(faces.contains(&face.index()));
+        }
+    }
+}
+
+#[test]
+fn add_above_the_terrain_and_remove_below_it_widen_the_bounds() {
+    // A sphere with room above and below its surface, columns about 5 m apart.
+    let layout = Layout::new(2, 16, 60.0, 1.0, 4).unwrap();
+    let mut planet = Planet::new(PresetKind::Sphere, 2, layout);
+    let (lo, hi) = planet.terrain().density.radial_bounds().unwrap();
+    let dir = DVec3::new(0.1, 0.2, -1.0).normalize();
+    // A ball floating 8 m above the surface and a cavern 6 m under it.
+    let tower = BrushOp::new(BrushKind::Add, dir * (hi + 14.0), 6.0, 1.0).unwrap();
+    let cavern = BrushOp::new(BrushKind::Remove, -dir * (lo - 12.0), 6.0, 1.0).unwrap();
+    planet.set_edits(vec![tower, cavern].into());
+    let (lo2, hi2) = planet.density().radial_bounds().unwrap();
+    assert!(hi2 >= hi + 20.0 && lo2 <= lo - 18.0, "({lo2}, {hi2}) vs ({lo}, {hi})");
+    let meshes = all_meshes(&planet);
+    assert_closed(&meshes);
+    let r = report(&meshes);
+    // The sphere, a floating ball and the inner wall of an enclosed cavern: three spheres.
+    assert_eq!(r.euler_characteristic(), 6, "{r:?}");
+    // Meshed through the skip logic and without it, the same.
+    let tops = meshes
+        .values()
+        .filter(|m| !m.is_empty())
+        .map(|m| m.key.unwrap().k)
+        .max();
+    assert!(
+        tops.unwrap() > 2,
+        "the floating ball lies in a chunk the terrain alone would skip"
+    );
+}
+
+#[test]
+fn paint_changes_materials_and_colours_inside_its_ball_only() {
+    let mut planet = Planet::new(PresetKind::Earthlike, 9, small_layout());
+    let before = all_meshes(&planet);
+    let snow = 4u8;
+    assert_eq!(planet.terrain().materials[usize::from(snow)], "snow");
+    let op = brush_at(
+        &planet,
+        BrushKind::Paint { material: snow },
+        DVec3::new(0.7, 0.1, 0.6),
+        8.0,
+    );
+    planet.set_edits(vec![op].into());
+    assert!(planet.density().radial_bounds() == planet.terrain().density.radial_bounds());
+    let after = all_meshes(&planet);
+    let listed = affected_chunks(planet.layout(), &op);
+    let mut painted = 0;
+    for (k, m) in &after {
+        let b = &before[k];
+        assert_eq!(
+            (&m.positions, &m.normals, &m.indices),
+            (&b.positions, &b.normals, &b.indices)
+        );
+        for i in 0..m.vertex_count() {
+            let p = m.world_position(i);
+            if (p - op.center).length() < op.radius {
+                painted += 1;
+                assert!(listed.contains(k));
+                assert_eq!(m.materials[i], snow);
+                assert_eq!(m.colors[i], planet.terrain().shader.shade_material(snow, p).color);
+            } else {
+                assert_eq!((m.materials[i], m.colors[i]), (b.materials[i], b.colors[i]));
+            }
+        }
+    }
+    assert!(painted > 3, "{painted} vertices painted");
+    // Paint past the terrain's material list is ignored.
+    let bogus = BrushOp::new(BrushKind::Paint { material: 200 }, op.center, 8.0, 1.0).unwrap();
+    planet.set_edits(EditSnapshot::from(vec![bogus]));
+    assert!(same(&all_meshes(&planet), &before));
+}
+
+#[test]
+fn a_brush_that_touches_no_sample_changes_nothing() {
+    let mut planet = Planet::new(PresetKind::Sphere, 1, small_layout());
+    let before = all_meshes(&planet);
+    // Far outside the shell.
+    let op = BrushOp::new(BrushKind::Add, DVec3::X * 500.0, 10.0, 1.0).unwrap();
+    assert!(affected_chunks(planet.layout(), &op).is_empty());
+    planet.set_edits(vec![op].into());
+    assert!(planet.remesh(&op).is_empty());
+    let after = all_meshes(&planet);
+    assert!(same(&before, &after));
+}
