@@ -214,12 +214,13 @@ fn parse_at(s: &str) -> Result<At, CliError> {
     Ok(At { lat, lon, alt })
 }
 
-/// The radius of the first surface met going down the ray `dir` from the top of the shell: the
+/// The radius of the first surface (of the edited planet) met going down the ray `dir` from the
+/// top of the shell: the
 /// density is sampled every quarter tile (`l_d / 4`) and the first sign change refined by
 /// bisection. The shell contract makes the base solid, so the answer is at least `d_b`.
 fn surface_radius(planet: &Planet, dir: DVec3) -> f64 {
     let l = planet.layout();
-    let density = &planet.terrain().density;
+    let density = planet.density();
     let solid = |r: f64| density.density(dir * r) > 0.0;
     let (top, bottom) = (l.radius(), l.d_b());
     if solid(top) {
@@ -314,7 +315,10 @@ fn planet_of(world: &World) -> Result<Planet, CliError> {
             world.path().display()
         ))
     })?;
-    Ok(Planet::new(kind, seed, layout))
+    // The world's edits are part of the planet: a brush placed "on the surface" lands on the
+    // edited ground (digging twice in one place goes deeper).
+    let edits = world.active_edits()?;
+    Ok(Planet::new(kind, seed, layout).with_edits(edits.into()))
 }
 
 /// Runs `pmc edit`.

@@ -474,3 +474,24 @@ fn every_acknowledged_edit_survives_sigkill() {
         "a journal remains after a commit"
     );
 }
+
+/// Without an altitude a brush lands on the surface of the edited planet: digging twice in one
+/// place goes deeper instead of hitting the untouched terrain again.
+#[test]
+fn digging_twice_in_one_place_goes_deeper() {
+    let d = dir("dig-twice");
+    let world = d.join("w.pmcw");
+    let mut args: Vec<&str> = PLANET.to_vec();
+    args.extend(["remove", "--at", "10,20", "--radius", "6"]);
+    edit_ok(&world, &args);
+    edit_ok(&world, &["remove", "--at", "10,20", "--radius", "6"]);
+    let w = World::open(&world).unwrap();
+    let ops = w.active_edits().unwrap();
+    assert_eq!(ops.len(), 2);
+    let (r1, r2) = (ops[0].center.length(), ops[1].center.length());
+    assert!(
+        r1 - r2 > 4.0,
+        "the second dig starts at the bottom of the first: {r1} then {r2}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
