@@ -307,7 +307,8 @@ fn brush_kind(planet: &Planet, brush: BrushName, mat: Option<&str>) -> Result<Br
     }
 }
 
-fn planet_of(world: &World) -> Result<Planet, CliError> {
+/// The planet of a world file, with its active edits.
+pub(crate) fn planet_of(world: &World) -> Result<Planet, CliError> {
     let (preset, seed, layout) = world.planet_params();
     let kind = preset.parse::<PresetKind>().map_err(|_| {
         CliError::Edit(format!(

@@ -20,6 +20,11 @@ pub struct GenerateArgs {
     #[arg(short = 'o', long = "output", default_value = "planet.glb", value_name = "PATH")]
     output: PathBuf,
 
+    /// Export the planet of this world file, with its edits (see `pmc edit`). The planet options
+    /// then come from the world and cannot be given.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "seed", "n_c", "n_t", "d_b", "l_d", "d_c"])]
+    world: Option<PathBuf>,
+
     /// Worker threads; 0 uses every core. The output does not depend on it.
     #[arg(long, default_value_t = 0, value_name = "N")]
     threads: usize,
@@ -40,12 +45,15 @@ fn check_output(path: &Path) -> Result<(), CliError> {
 
 /// Runs `pmc generate`.
 pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
-    let layout = args.planet.layout()?;
+    let planet = match &args.world {
+        Some(path) => crate::edit::planet_of(&pmc_world::World::open(path)?)?,
+        None => pmc_planet::Planet::new(args.planet.preset, args.planet.seed, args.planet.layout()?),
+    };
+    let layout = *planet.layout();
     work::check_whole_planet(&layout)?;
     check_output(&args.output)?;
     let pool = work::thread_pool(args.threads)?;
     let start = Instant::now();
-    let planet = pmc_planet::Planet::new(args.planet.preset, args.planet.seed, layout);
     let total = layout.chunk_count();
     let meshes = work::mesh_planet(&planet, &pool, args.quiet);
     let meshed = start.elapsed();

@@ -495,3 +495,46 @@ fn digging_twice_in_one_place_goes_deeper() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `pmc generate --world` exports the edited planet: a dig changes the exported mesh, and
+/// planet options cannot be mixed with a world.
+#[test]
+fn generate_exports_the_edited_world() {
+    let d = dir("generate-world");
+    let world = d.join("w.pmcw");
+    let plain = d.join("plain.ply");
+    let edited = d.join("edited.ply");
+    let mut gen: Vec<&str> = vec!["generate", "--quiet", "-o", plain.to_str().unwrap()];
+    gen.extend(PLANET);
+    let o = pmc(&gen);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let mut args: Vec<&str> = PLANET.to_vec();
+    args.extend(["remove", "--at", "10,20", "--radius", "12"]);
+    edit_ok(&world, &args);
+    let o = pmc(&[
+        "generate",
+        "--quiet",
+        "--world",
+        world.to_str().unwrap(),
+        "-o",
+        edited.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (a, b) = (std::fs::read(&plain).unwrap(), std::fs::read(&edited).unwrap());
+    assert!(a != b, "the dig shows in the export");
+    let o = pmc(&[
+        "generate",
+        "--world",
+        world.to_str().unwrap(),
+        "--preset",
+        "moon",
+        "-o",
+        edited.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(text(&o.stderr).contains("--preset"), "{}", text(&o.stderr));
+    let o = pmc(&["generate", "--world", d.join("missing.pmcw").to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(!text(&o.stderr).contains("panicked"));
+    let _ = std::fs::remove_dir_all(&d);
+}
