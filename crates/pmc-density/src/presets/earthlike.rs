@@ -287,10 +287,7 @@ impl Shader for EarthShader {
         self.palette.shade(self.material(p, normal), p)
     }
     fn shade_material(&self, material: u8, p: DVec3) -> Shade {
-        self.palette.try_shade(material, p).unwrap_or(Shade {
-            color: [128, 128, 128, 255],
-            material,
-        })
+        self.palette.shade_or_unknown(material, p)
     }
 }
 

@@ -99,11 +99,14 @@ pub trait Shader: Send + Sync {
     fn shade_material(&self, material: u8, p: DVec3) -> Shade {
         let _ = p;
         Shade {
-            color: [128, 128, 128, 255],
+            color: UNKNOWN_MATERIAL_COLOR,
             material,
         }
     }
 }
+
+/// The neutral grey of a material a shader does not know (linear RGBA).
+pub const UNKNOWN_MATERIAL_COLOR: [u8; 4] = [128, 128, 128, 255];
 
 /// A planet's terrain: density, sea and look, ready to mesh.
 #[derive(Clone)]

@@ -68,9 +68,16 @@ impl Palette {
         (0.5 + 2.5 * self.mix.sample(p * self.inv_len)).clamp(0.0, 1.0)
     }
 
-    /// The shade of material `id` at `p`, or `None` for an id past the palette.
-    pub fn try_shade(&self, id: u8, p: DVec3) -> Option<Shade> {
-        (usize::from(id) < self.materials.len()).then(|| self.shade(id, p))
+    /// The shade of material `id` at `p`; ids past the palette get [`super::UNKNOWN_MATERIAL_COLOR`].
+    pub fn shade_or_unknown(&self, id: u8, p: DVec3) -> Shade {
+        if usize::from(id) < self.materials.len() {
+            self.shade(id, p)
+        } else {
+            Shade {
+                color: super::UNKNOWN_MATERIAL_COLOR,
+                material: id,
+            }
+        }
     }
 
     /// The shade of material `id` at `p`.

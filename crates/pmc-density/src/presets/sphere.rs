@@ -31,7 +31,7 @@ impl Shader for Grey {
         let color = if usize::from(material) < MATERIALS.len() {
             self.0
         } else {
-            [128, 128, 128, 255]
+            super::UNKNOWN_MATERIAL_COLOR
         };
         Shade { color, material }
     }
