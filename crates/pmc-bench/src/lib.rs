@@ -4,7 +4,7 @@
 
 use pmc_density::Density;
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{sphere_to_face_uv, ChunkGrid, ChunkKey, LatLon, Layout};
+use pmc_geometry::{sphere_to_face_uv, ChunkGrid, ChunkKey, Face, LatLon, Layout};
 use pmc_mesh::{close_shell, ChunkMesh, Mesher};
 use pmc_planet::{Planet, PresetKind};
 
@@ -18,10 +18,10 @@ pub fn default_planet() -> Planet {
 pub fn surface_chunk(planet: &Planet) -> ChunkKey {
     let l = planet.layout();
     let k = l.d_c() - 1;
-    let mut best = (0, ChunkKey::new(pmc_geometry::Face::Top, 0, 0, k));
+    let mut best = (0, ChunkKey::new(Face::Top, 0, 0, k));
     for i in 0..l.n_c() {
         for j in 0..l.n_c() {
-            let key = ChunkKey::new(pmc_geometry::Face::Top, i, j, k);
+            let key = ChunkKey::new(Face::Top, i, j, k);
             let tris = planet.chunk_mesh(key).triangle_count();
             if tris > best.0 {
                 best = (tris, key);
@@ -83,5 +83,15 @@ pub fn nearest_column(layout: &Layout, p: DVec3) -> DVec3 {
     let n = layout.face_tiles();
     let index = |x: f64| (((x + 1.0) * 0.5 * n as f64).round() as i64).clamp(0, n);
     let l = layout.lattice(face, index(u), index(v)).expect("an index on the face");
+    layout.lattice_direction(l)
+}
+
+/// The direction of the voxel column where the level-0 chunks `(i - 1, j - 1)`, `(i, j - 1)`,
+/// `(i - 1, j)` and `(i, j)` of `face` meet (chunk corner indices `0..=n_c`).
+pub fn chunk_corner(layout: &Layout, face: Face, i: u32, j: u32) -> DVec3 {
+    let n_t = i64::from(layout.n_t());
+    let l = layout
+        .lattice(face, i64::from(i) * n_t, i64::from(j) * n_t)
+        .expect("a chunk corner on the face");
     layout.lattice_direction(l)
 }

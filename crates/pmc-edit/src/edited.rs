@@ -70,43 +70,22 @@ impl<D: Density> EditedDensity<D> {
         &self.edits
     }
 
-    /// The density at `p` after the shaping operations before index `end` of the snapshot.
-    fn density_before(&self, end: usize, p: DVec3) -> f64 {
-        let mut d = self.base.density(p);
-        for &i in &self.shaping {
-            if i >= end {
-                break;
-            }
-            d = self.apply_at(i, d, p);
-        }
-        d
-    }
-
-    /// Applies operation `i` to density `d` at `p` when `p` lies inside its reach.
-    #[inline]
-    fn apply_at(&self, i: usize, d: f64, p: DVec3) -> f64 {
-        let op = &self.edits[i];
-        let q = (p - op.center).length();
-        if q < op.reach() {
-            op.apply(d, p, q, |x| self.density_before(i, x))
-        } else {
-            d
-        }
-    }
-}
-
-impl<D: Density> Density for EditedDensity<D> {
-    fn density(&self, p: DVec3) -> f64 {
-        self.density_before(usize::MAX, p)
-    }
-
-    /// The base batch, then each shaping operation whose reach meets the batch's bounding cone
-    /// shell, applied only to the samples inside its reach (column by column: a column is skipped
-    /// when its line misses the ball, and only the radii whose sample can lie in the ball are
-    /// tested). Each operation's result is stored as `f32` before the next one applies, at every
-    /// sample the same way, so the output is a function of the sample's position alone.
-    fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
-        self.base.sample_shell(dirs, radii, out);
+    /// Applies the shaping operations, in order, to a batch that already holds the base density's
+    /// batch for `dirs` × `radii` (exactly what `self.base().sample_shell(dirs, radii, out)`
+    /// writes, for instance a copy of it kept from an earlier call). Base batch plus this is
+    /// [`Density::sample_shell`] of the edited density, bit for bit; a caller that caches base
+    /// batches (the base does not change when edits do) pays only for the edits.
+    ///
+    /// Each operation whose reach meets the batch's bounding cone shell applies only to the
+    /// samples inside its reach (column by column: a column is skipped when its line misses the
+    /// ball, and only the radii whose sample can lie in the ball are tested). Each operation's
+    /// result is stored as `f32` before the next one applies, at every sample the same way, so
+    /// the output is a function of the sample's position (and base value) alone.
+    ///
+    /// # Panics
+    /// If `out.len() != dirs.len() * radii.len()`.
+    pub fn apply_edits(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
         if self.shaping.is_empty() || dirs.is_empty() {
             return;
         }
@@ -150,6 +129,43 @@ impl<D: Density> Density for EditedDensity<D> {
                 }
             }
         }
+    }
+
+    /// The density at `p` after the shaping operations before index `end` of the snapshot.
+    fn density_before(&self, end: usize, p: DVec3) -> f64 {
+        let mut d = self.base.density(p);
+        for &i in &self.shaping {
+            if i >= end {
+                break;
+            }
+            d = self.apply_at(i, d, p);
+        }
+        d
+    }
+
+    /// Applies operation `i` to density `d` at `p` when `p` lies inside its reach.
+    #[inline]
+    fn apply_at(&self, i: usize, d: f64, p: DVec3) -> f64 {
+        let op = &self.edits[i];
+        let q = (p - op.center).length();
+        if q < op.reach() {
+            op.apply(d, p, q, |x| self.density_before(i, x))
+        } else {
+            d
+        }
+    }
+}
+
+impl<D: Density> Density for EditedDensity<D> {
+    fn density(&self, p: DVec3) -> f64 {
+        self.density_before(usize::MAX, p)
+    }
+
+    /// The base batch, then [`EditedDensity::apply_edits`]: each shaping operation whose reach
+    /// meets the batch's bounding cone shell, applied only to the samples inside its reach.
+    fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        self.base.sample_shell(dirs, radii, out);
+        self.apply_edits(dirs, radii, out);
     }
 
     fn radial_bounds(&self) -> Option<(f64, f64)> {
@@ -243,8 +259,9 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
-        /// The batch call equals point calls (to f32 rounding), leaves samples outside every reach
-        /// bit-identical to the base, and is continuous across each brush's edge.
+        /// The batch call equals point calls (to f32 rounding), equals the base batch followed by
+        /// `apply_edits` bit for bit, leaves samples outside every reach bit-identical to the base,
+        /// and is continuous across each brush's edge.
         #[test]
         fn batch_matches_points_and_is_local(
             kinds_idx in proptest::collection::vec(0usize..5, 1..5),
@@ -263,6 +280,11 @@ mod tests {
             let mut base = got.clone();
             e.sample_shell(&dirs, &radii, &mut got);
             wavy().sample_shell(&dirs, &radii, &mut base);
+            // The edits applied over a copy of the base batch: the same bits.
+            let mut over = vec![0.0f32; got.len()];
+            e.base().sample_shell(&dirs, &radii, &mut over);
+            e.apply_edits(&dirs, &radii, &mut over);
+            prop_assert!(over.iter().zip(&got).all(|(a, b)| a.to_bits() == b.to_bits()));
             for (ri, r) in radii.iter().enumerate() {
                 for (di, d) in dirs.iter().enumerate() {
                     let p = *d * *r;

@@ -7,7 +7,9 @@
 //! computed from canonical voxel keys alone and results are ordered by chunk key.
 //!
 //! Edits ([`pmc_edit`] brush operations) apply through [`Planet::set_edits`]; after an edit,
-//! [`Planet::remesh`] meshes exactly the chunks it can change.
+//! [`Planet::remesh`] meshes exactly the chunks it can change. With
+//! [`Planet::with_base_cache`] the terrain's density batches are kept per chunk, so remeshing
+//! after an edit pays only for the edit, not for the terrain noise again.
 //!
 //! ```
 //! use pmc_planet::{Planet, PresetKind};
@@ -19,8 +21,10 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod cache;
 mod planet;
 
+pub use cache::BaseCacheStats;
 pub use planet::{ChunkScratch, Planet};
 pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};
 pub use pmc_edit;

@@ -535,3 +535,126 @@ fn a_brush_that_touches_no_sample_changes_nothing() {
     let after = all_meshes(&planet);
     assert!(same(&before, &after));
 }
+
+/// A random step of an editing session: push a brush, or undo the last one.
+#[derive(Clone, Copy, Debug)]
+enum Step {
+    Push(RandomOp),
+    Undo,
+}
+
+fn step() -> impl Strategy<Value = Step> {
+    prop_oneof![
+        4 => random_op().prop_map(Step::Push),
+        1 => Just(Step::Undo),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// The base density cache changes no byte: random sessions of all five brushes (face edges
+    /// and cube corners included) and undos give the same meshes on a cached planet as on an
+    /// uncached one, chunk by chunk, with the cache cold, warm, and evicting (a bound smaller
+    /// than the planet), through `chunk_mesh`, `remesh`, `remesh_reusing` and `generate`.
+    #[test]
+    fn the_base_cache_changes_no_byte(
+        sphere in any::<bool>(),
+        seed in 0u64..1000,
+        small_bound in any::<bool>(),
+        steps in proptest::collection::vec(step(), 1..6),
+    ) {
+        let max_chunks = if small_bound { 5 } else { 1000 };
+        let mut plain = Planet::new(preset(sphere), seed, small_layout());
+        let mut cached = plain.clone().with_base_cache(max_chunks);
+        // Cold: every chunk misses (or is skipped without sampling).
+        let mut meshes = all_meshes(&cached);
+        prop_assert!(same(&meshes, &all_meshes(&plain)), "cold cache");
+        let mut log = EditLog::new();
+        for s in steps {
+            let op = match s {
+                Step::Push(r) => {
+                    let op = r.resolve(&plain);
+                    log.push(op);
+                    op
+                }
+                Step::Undo => match log.undo() {
+                    Some(op) => op,
+                    None => continue,
+                },
+            };
+            plain.set_edits(log.snapshot());
+            cached.set_edits(log.snapshot());
+            let expected = plain.remesh(&op);
+            let warm = cached.remesh(&op);
+            let reused = cached.remesh_reusing(&op, |k| meshes.get(k));
+            prop_assert_eq!(expected.len(), warm.len());
+            prop_assert_eq!(expected.len(), reused.len());
+            for ((e, w), r) in expected.iter().zip(&warm).zip(&reused) {
+                prop_assert!(bytes(e) == bytes(w), "remesh {:?} after {op:?}", e.key);
+                prop_assert!(bytes(e) == bytes(r), "remesh_reusing {:?} after {op:?}", e.key);
+            }
+            for m in warm {
+                meshes.insert(m.key.unwrap(), m);
+            }
+            let fresh = all_meshes(&cached);
+            prop_assert!(same(&fresh, &all_meshes(&plain)), "all chunks after {op:?}");
+            prop_assert!(same(&fresh, &meshes));
+            let stats = cached.base_cache_stats().unwrap();
+            // A bound smaller than the planet thrashes under whole-planet sweeps (all misses).
+            prop_assert!(stats.chunks <= max_chunks && (small_bound || stats.hits > 0), "{stats:?}");
+        }
+        // A cold cache on the edited planet, and the parallel generator on the warm one.
+        let cold = plain.clone().with_base_cache(max_chunks);
+        prop_assert!(same(&all_meshes(&cold), &meshes), "cold cache with edits");
+        let generated = cached.generate(|_| {});
+        let nonempty: Vec<&ChunkMesh> = meshes.values().filter(|m| !m.is_empty()).collect();
+        prop_assert_eq!(generated.len(), nonempty.len());
+        for (g, m) in generated.iter().zip(nonempty) {
+            prop_assert!(bytes(g) == bytes(m));
+        }
+    }
+}
+
+#[test]
+fn the_base_cache_is_bounded_and_shared_by_clones() {
+    let plain = Planet::new(PresetKind::Earthlike, 4, small_layout());
+    assert!(plain.base_cache_stats().is_none(), "off by default");
+    assert!(
+        plain.clone().with_base_cache(0).base_cache_stats().is_none(),
+        "0 is off"
+    );
+    let planet = plain.with_base_cache(5);
+    let mut clone = planet.clone();
+    let mut sampled = Vec::new();
+    for key in planet.layout().chunks(0) {
+        let _ = clone.chunk_mesh(key);
+        let s = planet.base_cache_stats().unwrap();
+        assert!(s.chunks <= 5, "{s:?}");
+        assert_eq!(s.chunks, (s.misses as usize).min(5), "{s:?}");
+        if s.misses as usize > sampled.len() {
+            sampled.push(key);
+        }
+    }
+    assert!(
+        sampled.len() > 5,
+        "the planet has more chunks with surface than the bound"
+    );
+    let s = planet.base_cache_stats().unwrap();
+    assert_eq!((s.hits, s.max_chunks), (0, 5));
+    let grid = ChunkGrid::new(planet.layout(), sampled[0]);
+    assert_eq!(s.bytes, 5 * grid.sample_count() * 4);
+    assert_eq!(grid.sample_count(), 11 * 11 * 11, "(n_t + 3)^3 samples");
+    // The clone filled the original's cache: the last five chunks sampled are there (edits do not
+    // invalidate it), the first ones were dropped.
+    clone.set_edits(vec![BrushOp::new(BrushKind::Remove, DVec3::Y * 68.0, 5.0, 1.0).unwrap()].into());
+    for key in &sampled[sampled.len() - 5..] {
+        let _ = planet.chunk_mesh(*key);
+        let _ = clone.chunk_mesh(*key);
+    }
+    let s2 = planet.base_cache_stats().unwrap();
+    assert_eq!((s2.hits, s2.misses), (10, s.misses));
+    let _ = planet.chunk_mesh(sampled[0]);
+    let s3 = planet.base_cache_stats().unwrap();
+    assert_eq!((s3.hits, s3.misses, s3.chunks), (10, s.misses + 1, 5));
+}
