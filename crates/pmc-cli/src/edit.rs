@@ -134,6 +134,19 @@ struct DefaultPlanet {
 }
 
 impl WorldPlanetArgs {
+    /// The options of `planet` that `given` says were typed on the command line.
+    pub(crate) fn typed(planet: &PlanetArgs, given: &dyn Fn(&str) -> bool) -> WorldPlanetArgs {
+        WorldPlanetArgs {
+            preset: given("preset").then_some(planet.preset),
+            seed: given("seed").then_some(planet.seed),
+            n_c: given("n_c").then_some(planet.n_c),
+            n_t: given("n_t").then_some(planet.n_t),
+            d_b: given("d_b").then_some(planet.d_b),
+            l_d: given("l_d").then_some(planet.l_d),
+            d_c: given("d_c").then_some(planet.d_c),
+        }
+    }
+
     /// The planet of a new world: the given options, the defaults of `pmc generate` elsewhere.
     fn for_new_world(&self) -> Result<(PresetKind, u64, Layout), CliError> {
         let d = DefaultPlanet::parse_from(["pmc"]).planet;
@@ -148,7 +161,7 @@ impl WorldPlanetArgs {
     }
 
     /// Refuses options that disagree with the world's planet, naming each.
-    fn check_against(&self, world: &World) -> Result<(), CliError> {
+    pub(crate) fn check_against(&self, world: &World) -> Result<(), CliError> {
         let (preset, seed, l) = world.planet_params();
         let mut diffs = Vec::new();
         let mut cmp = |name: &str, given: Option<String>, stored: String| {
@@ -176,18 +189,23 @@ impl WorldPlanetArgs {
     }
 }
 
-/// Where the brush goes: `LAT,LON[,ALT]`.
+/// A place: `LAT,LON[,ALT]` (degrees, and metres above the datum).
 #[derive(Clone, Copy, Debug)]
-struct At {
-    lat: f64,
-    lon: f64,
-    alt: Option<f64>,
+pub(crate) struct At {
+    pub(crate) lat: f64,
+    pub(crate) lon: f64,
+    pub(crate) alt: Option<f64>,
 }
 
 fn parse_at(s: &str) -> Result<At, CliError> {
+    parse_place("--at", s)
+}
+
+/// Parses the value `s` of option `opt` as `LAT,LON[,ALT]`.
+pub(crate) fn parse_place(opt: &str, s: &str) -> Result<At, CliError> {
     let err = |why: String| {
         CliError::Edit(format!(
-            "--at {s}: {why}; give LAT,LON or LAT,LON,ALT (degrees, metres)"
+            "{opt} {s}: {why}; give LAT,LON or LAT,LON,ALT (degrees, metres)"
         ))
     };
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -5,12 +5,13 @@ mod edit;
 mod error;
 mod generate;
 mod info;
+mod path;
 mod planet_args;
 mod render;
 mod serve;
 mod work;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Planetary marching cubes: closed planets with caves and overhangs, meshed on a cube-sphere.
@@ -33,16 +34,32 @@ enum Command {
     Serve(serve::ServeArgs),
     /// Dig and build: apply a brush to a planet kept in a world file, undo, redo, list edits.
     Edit(edit::EditArgs),
+    /// Find a walking path between two places over the navigation grid (JSON or GeoJSON).
+    Path(path::PathArgs),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     let result = match &cli.command {
         Command::Generate(a) => generate::run(a),
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
-        Command::Serve(a) => serve::run(a),
+        Command::Serve(a) => {
+            // Which planet options were typed matters when a world file already holds a planet.
+            let given = |id: &str| {
+                matches
+                    .subcommand_matches("serve")
+                    .and_then(|m| m.value_source(id))
+                    .is_some_and(|s| s == clap::parser::ValueSource::CommandLine)
+            };
+            serve::run(a, &given)
+        }
         Command::Edit(a) => edit::run(a),
+        Command::Path(a) => path::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,11 +1,13 @@
 //! `pmc serve`: the web viewer and the HTTP API, streaming chunks of a planet generated on demand.
 
+use crate::edit::WorldPlanetArgs;
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
 use clap::Args;
-use pmc_server::{Server, ServerConfig};
+use pmc_server::{EditLimits, Server, ServerConfig};
 use std::io::{IsTerminal, Write};
 use std::net::{IpAddr, Ipv4Addr};
+use std::path::PathBuf;
 
 /// Options of `pmc serve`.
 #[derive(Args, Debug)]
@@ -29,6 +31,25 @@ pub struct ServeArgs {
     /// Most megabytes (MiB) of encoded chunks kept in memory.
     #[arg(long = "cache-mb", default_value_t = 512, value_name = "MIB")]
     cache_mb: u64,
+
+    /// Serve and edit this world file (SQLite, format pmc-world v1; see `pmc edit`): the viewer
+    /// gets its dig, build, smooth, flatten and paint tools, and every edit is saved durably. A
+    /// missing file is created with the planet options; an existing one keeps its own planet
+    /// (planet options given must agree with it).
+    #[arg(long, value_name = "FILE")]
+    world: Option<PathBuf>,
+
+    /// Largest brush radius, metres, that clients may use (with --world).
+    #[arg(long = "max-brush-radius", default_value_t = EditLimits::default().max_brush_radius, value_name = "METRES", allow_negative_numbers = true)]
+    max_brush_radius: f64,
+
+    /// Edits per second one client address may send on average (with --world).
+    #[arg(long = "edit-rate", default_value_t = EditLimits::default().rate_per_second, value_name = "PER_SECOND", allow_negative_numbers = true)]
+    edit_rate: f64,
+
+    /// Edits one client address may send at once before --edit-rate applies (with --world).
+    #[arg(long = "edit-burst", default_value_t = EditLimits::default().burst, value_name = "N")]
+    edit_burst: u32,
 }
 
 /// Parses `--host`: an IP address or "localhost" (no name lookups).
@@ -42,10 +63,16 @@ fn parse_host(s: &str) -> Result<IpAddr, CliError> {
         .map_err(|_| CliError::Host(s.to_string()))
 }
 
-/// Runs `pmc serve` until Ctrl-C or SIGTERM.
-pub fn run(args: &ServeArgs) -> Result<(), CliError> {
+/// Runs `pmc serve` until Ctrl-C or SIGTERM. `given` tells which planet options were typed.
+pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliError> {
     let layout = args.planet.layout()?;
     let host = parse_host(&args.host)?;
+    if let Some(path) = args.world.as_deref().filter(|p| std::fs::symlink_metadata(p).is_ok()) {
+        // An existing world keeps its planet: typed options that disagree are a mistake.
+        let world = pmc_world::World::open(path)?;
+        WorldPlanetArgs::typed(&args.planet, given).check_against(&world)?;
+        world.close()?;
+    }
     let config = ServerConfig {
         host,
         port: args.port,
@@ -54,6 +81,13 @@ pub fn run(args: &ServeArgs) -> Result<(), CliError> {
         layout,
         cache_bytes: args.cache_mb.saturating_mul(1 << 20),
         threads: args.threads,
+        world: args.world.clone(),
+        edit_limits: EditLimits {
+            max_brush_radius: args.max_brush_radius,
+            rate_per_second: args.edit_rate,
+            burst: args.edit_burst,
+            ..EditLimits::default()
+        },
         ..ServerConfig::default()
     };
     init_logging();

@@ -68,6 +68,12 @@ impl IntoResponse for ApiError {
     }
 }
 
+impl From<ApiError> for Response {
+    fn from(e: ApiError) -> Response {
+        e.into_response()
+    }
+}
+
 /// A JSON answer that browsers revalidate.
 fn json_response(v: Value, cache: &'static str) -> Response {
     let mut r = Json(v).into_response();
@@ -77,22 +83,23 @@ fn json_response(v: Value, cache: &'static str) -> Response {
 }
 
 /// The decoded query parameters (the last of repeated names wins).
-struct Params(Vec<(String, String)>);
+pub(crate) struct Params(Vec<(String, String)>);
 
 impl Params {
-    fn parse(q: Option<String>) -> Params {
+    /// Decodes a raw query string.
+    pub(crate) fn parse(q: Option<String>) -> Params {
         Params(
             q.map(|q| form_urlencoded::parse(q.as_bytes()).into_owned().collect())
                 .unwrap_or_default(),
         )
     }
 
-    fn get(&self, name: &str) -> Option<&str> {
+    pub(crate) fn get(&self, name: &str) -> Option<&str> {
         self.0.iter().rev().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
     }
 
     /// A required finite number.
-    fn finite(&self, name: &str) -> Result<f64, ApiError> {
+    pub(crate) fn finite(&self, name: &str) -> Result<f64, ApiError> {
         let raw = self.get(name).ok_or_else(|| {
             ApiError::bad_request(format!(
                 "missing query parameter '{name}' (a finite number of metres, planet frame)"
@@ -107,7 +114,7 @@ impl Params {
     }
 
     /// The planet the request names (or the server's).
-    fn planet(&self, state: &AppState) -> Result<PlanetId, ApiError> {
+    pub(crate) fn planet(&self, state: &AppState) -> Result<PlanetId, ApiError> {
         let c = state.config();
         let preset = match self.get("preset") {
             None => c.preset,
@@ -129,7 +136,7 @@ impl Params {
 }
 
 async fn planet_of(state: &AppState, id: PlanetId) -> Result<std::sync::Arc<pmc_planet::Planet>, ApiError> {
-    state.planet(id).await.map_err(ApiError::internal)
+    state.planet(id).await.map(|(p, _)| p).map_err(ApiError::internal)
 }
 
 /// `GET /api/v1/health`.
@@ -179,6 +186,7 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
         "faces": faces,
         "materials": t.materials,
         "palette": { "a": t.blend_colors[0], "b": t.blend_colors[1] },
+        "edit": crate::edit_api::edit_info(&state, id),
     });
     Ok(json_response(v, "no-cache"))
 }
@@ -301,8 +309,7 @@ pub async fn chunk(
     if !layout.contains_chunk(&key) {
         return Err(ApiError::not_found(format!("chunk {shown} is not part of this planet")));
     }
-    let planet = planet_of(&state, id).await?;
-    match state.chunk(planet, ChunkId { planet: id, key }).await {
+    match state.chunk(ChunkId { planet: id, key }).await {
         Ok(bytes) => {
             let mut r = bytes.into_response();
             let h = r.headers_mut();
@@ -318,6 +325,7 @@ pub async fn chunk(
             message: "the server is busy generating chunks; retry in a second".into(),
         }),
         Err(ChunkError::Failed(e)) => Err(ApiError::internal(e.to_string())),
+        Err(ChunkError::Stale) => Err(ApiError::internal("the chunk's planet changed while it was requested")),
     }
 }
 
@@ -330,15 +338,22 @@ pub async fn stats(State(state): State<AppState>) -> Response {
 pub async fn not_found(uri: Uri) -> ApiError {
     ApiError::not_found(format!(
         "no such API endpoint: {}; see docs/specs/http-api-v1.md (GET /api/v1/health, /planet, /chunks, \
-         /chunk/FACE/LEVEL/I/J/K, /stats)",
+         /chunk/FACE/LEVEL/I/J/K, /stats, /edits, /events, /path, /navgrid; POST /api/v1/edits, /edits/undo, \
+         /edits/redo)",
         uri.path()
     ))
 }
 
-/// A method other than GET (or HEAD) on an API path.
-pub async fn method_not_allowed() -> ApiError {
+/// A method an API path does not take.
+pub async fn method_not_allowed(uri: Uri) -> ApiError {
+    let post = ["/api/v1/edits", "/api/v1/edits/undo", "/api/v1/edits/redo"];
+    let allowed = match uri.path() {
+        "/api/v1/edits" => "GET and POST",
+        p if post.contains(&p) => "POST",
+        _ => "GET",
+    };
     ApiError {
         status: StatusCode::METHOD_NOT_ALLOWED,
-        message: "only GET is supported".into(),
+        message: format!("{} takes {allowed} only", uri.path()),
     }
 }

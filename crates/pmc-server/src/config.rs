@@ -4,6 +4,33 @@ use crate::ServerError;
 use pmc_geometry::Layout;
 use pmc_planet::PresetKind;
 use std::net::{IpAddr, Ipv4Addr};
+use std::path::PathBuf;
+
+/// Limits on edits sent to the server (`POST /api/v1/edits`, undo and redo).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EditLimits {
+    /// Smallest brush radius accepted, metres (default 0.5).
+    pub min_brush_radius: f64,
+    /// Largest brush radius accepted, metres (default 64; at most
+    /// [`pmc_edit::MAX_BRUSH_RADIUS`]).
+    pub max_brush_radius: f64,
+    /// Edits (undo and redo included) per second one client address may send, on average
+    /// (default 20).
+    pub rate_per_second: f64,
+    /// Edits one client address may send at once before the rate applies (default 40).
+    pub burst: u32,
+}
+
+impl Default for EditLimits {
+    fn default() -> Self {
+        EditLimits {
+            min_brush_radius: 0.5,
+            max_brush_radius: 64.0,
+            rate_per_second: 20.0,
+            burst: 40,
+        }
+    }
+}
 
 /// The server's settings. [`ServerConfig::default`] serves the default planet (earthlike, seed 7,
 /// the default layout) on `127.0.0.1:8080`.
@@ -28,6 +55,15 @@ pub struct ServerConfig {
     pub queue_limit: usize,
     /// Worker threads that generate chunks; 0 uses every core.
     pub threads: usize,
+    /// The world file to serve and edit (created when missing, with `preset`, `seed` and
+    /// `layout`). With a world, its planet is the server's default planet: an existing world's
+    /// preset, seed and layout replace those above. `None`: no editing.
+    pub world: Option<PathBuf>,
+    /// Limits on edits (with a world).
+    pub edit_limits: EditLimits,
+    /// Chunks whose base terrain samples the edited planet keeps to remesh edits fast (with a
+    /// world; about 171 KB each at `n_t` 32).
+    pub base_cache_chunks: usize,
 }
 
 impl Default for ServerConfig {
@@ -42,6 +78,9 @@ impl Default for ServerConfig {
             max_planets: 4,
             queue_limit: 256,
             threads: 0,
+            world: None,
+            edit_limits: EditLimits::default(),
+            base_cache_chunks: 256,
         }
     }
 }
@@ -56,6 +95,26 @@ impl ServerConfig {
             return Err(ServerError::Config(
                 "queue_limit must be at least 1 (jobs waiting for a worker)".into(),
             ));
+        }
+        let e = &self.edit_limits;
+        if !(e.min_brush_radius > 0.0 && e.min_brush_radius <= e.max_brush_radius) {
+            return Err(ServerError::Config(format!(
+                "the smallest brush radius must be above 0 and at most the largest, got {} and {}",
+                e.min_brush_radius, e.max_brush_radius
+            )));
+        }
+        if e.max_brush_radius > pmc_edit::MAX_BRUSH_RADIUS {
+            return Err(ServerError::Config(format!(
+                "the largest brush radius must be at most {} m, got {}",
+                pmc_edit::MAX_BRUSH_RADIUS,
+                e.max_brush_radius
+            )));
+        }
+        if !(e.rate_per_second > 0.0 && e.rate_per_second.is_finite()) || e.burst == 0 {
+            return Err(ServerError::Config(format!(
+                "the edit rate must be a finite number above 0 per second and the burst at least 1, got {} and {}",
+                e.rate_per_second, e.burst
+            )));
         }
         Ok(())
     }

@@ -44,6 +44,9 @@ pub enum ServerError {
         /// The system's reason.
         reason: String,
     },
+    /// The world file could not be opened or created.
+    #[error(transparent)]
+    World(#[from] pmc_world::WorldError),
     /// Serving failed after start.
     #[error("the server stopped: {0}")]
     Io(#[from] std::io::Error),

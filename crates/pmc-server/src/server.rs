@@ -1,15 +1,15 @@
 //! The router, listening, and shutdown.
 
-use crate::{api, assets, AppState, ServerConfig, ServerError};
+use crate::{api, assets, edit_api, nav_api, AppState, ServerConfig, ServerError};
 use axum::extract::Request;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
-use axum::routing::{any, get};
+use axum::routing::{any, get, post};
 use axum::Router;
 use std::future::Future;
 use std::net::SocketAddr;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::compression::CompressionLayer;
 
@@ -49,6 +49,12 @@ pub fn router(state: AppState) -> Router {
         .route("/api/v1/chunks", get(api::chunks))
         .route("/api/v1/chunk/{face}/{level}/{i}/{j}/{k}", get(api::chunk))
         .route("/api/v1/stats", get(api::stats))
+        .route("/api/v1/edits", get(edit_api::list).post(edit_api::post_edit))
+        .route("/api/v1/edits/undo", post(edit_api::undo))
+        .route("/api/v1/edits/redo", post(edit_api::redo))
+        .route("/api/v1/events", get(edit_api::events))
+        .route("/api/v1/path", get(nav_api::path))
+        .route("/api/v1/navgrid", get(nav_api::navgrid))
         .route("/api", any(api::not_found))
         .route("/api/", any(api::not_found))
         .route("/api/{*rest}", any(api::not_found))
@@ -114,11 +120,35 @@ impl Server {
                 " (viewer not built: / shows how to build it)"
             }
         );
-        axum::serve(self.listener, router(self.state))
-            .with_graceful_shutdown(shutdown)
-            .await?;
+        if let Some(e) = self.state.editing() {
+            tracing::info!("editing world {}", e.path().display());
+            tokio::spawn(watch_world(self.state.clone()));
+        }
+        let app = router(self.state).into_make_service_with_connect_info::<SocketAddr>();
+        axum::serve(self.listener, app).with_graceful_shutdown(shutdown).await?;
         tracing::info!("PMC server stopped");
         Ok(())
+    }
+}
+
+/// How often the world file is checked for edits made by other programs.
+const WORLD_CHECK: Duration = Duration::from_secs(1);
+
+/// Takes edits that other programs (`pmc edit`) make to the world file, once a second.
+async fn watch_world(state: AppState) {
+    let mut tick = tokio::time::interval(WORLD_CHECK);
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut failing = false;
+    loop {
+        tick.tick().await;
+        match state.sync_world().await {
+            Ok(_) => failing = false,
+            Err(e) if !failing => {
+                failing = true;
+                tracing::warn!("cannot check the world file for changes by other programs: {e}");
+            }
+            Err(_) => {}
+        }
     }
 }
 

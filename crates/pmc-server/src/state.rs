@@ -1,12 +1,14 @@
 //! The state shared by every request.
 
+use crate::editing::{Action, Editing, Outcome};
 use crate::generator::{ChunkError, ChunkId, Generator, PlanetId};
 use crate::planets::Planets;
 use crate::{ServerConfig, ServerError};
 use axum::body::Bytes;
+use pmc_nav::{Agent, NavGrid};
 use pmc_planet::Planet;
 use std::sync::atomic::Ordering;
-use std::sync::Arc;
+use std::sync::{Arc, PoisonError};
 
 /// The server's state: its settings, the planets it holds, the chunk generator and cache. Cheap
 /// to clone (shared).
@@ -19,6 +21,24 @@ struct Inner {
     config: ServerConfig,
     planets: Planets,
     generator: Arc<Generator>,
+    editing: Option<Arc<Editing>>,
+    /// Navigation grids recently used, most recent last.
+    navs: std::sync::Mutex<std::collections::VecDeque<NavEntry>>,
+}
+
+/// Navigation grids kept besides the world's default one.
+const MAX_NAV_GRIDS: usize = 3;
+
+/// A navigation grid of a planet version for an agent.
+struct NavEntry {
+    planet: PlanetId,
+    revision: u64,
+    agent: [u64; 4],
+    grid: Arc<NavGrid>,
+}
+
+fn agent_key(a: &Agent) -> [u64; 4] {
+    [a.clearance, a.step_up, a.step_down, a.max_slope].map(f64::to_bits)
 }
 
 /// A snapshot of the counters of `/api/v1/stats`.
@@ -47,9 +67,34 @@ impl std::fmt::Debug for AppState {
 }
 
 impl AppState {
-    /// Checks `config` and starts the worker threads.
-    pub fn new(config: ServerConfig) -> Result<AppState, ServerError> {
+    /// Checks `config`, opens (or creates) its world when it names one, and starts the worker
+    /// threads. With a world, [`AppState::config`] holds the world's preset, seed and layout.
+    pub fn new(mut config: ServerConfig) -> Result<AppState, ServerError> {
         config.validate()?;
+        let editing = match &config.world {
+            None => None,
+            Some(path) => {
+                let (editing, created) = Editing::open(
+                    path,
+                    config.preset,
+                    config.seed,
+                    &config.layout,
+                    config.edit_limits,
+                    config.base_cache_chunks,
+                )?;
+                let c = editing.current();
+                tracing::info!(
+                    "{} world {}: {} active edits, {} undone",
+                    if created { "created" } else { "opened" },
+                    path.display(),
+                    c.active,
+                    c.redo
+                );
+                (config.preset, config.seed) = editing.id;
+                config.layout = *editing.layout();
+                Some(Arc::new(editing))
+            }
+        };
         let generator = Generator::new(config.threads, config.queue_limit, config.cache_bytes).map_err(|reason| {
             ServerError::Threads {
                 threads: config.threads,
@@ -60,6 +105,8 @@ impl AppState {
             inner: Arc::new(Inner {
                 planets: Planets::new(config.layout, config.max_planets),
                 generator: Arc::new(generator),
+                editing,
+                navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
                 config,
             }),
         })
@@ -85,8 +132,27 @@ impl AppState {
         }
     }
 
-    /// The planet `id`, built (off the async runtime) when it is not held.
-    pub(crate) async fn planet(&self, id: PlanetId) -> Result<Arc<Planet>, String> {
+    /// The world being edited, if the server has one.
+    pub(crate) fn editing(&self) -> Option<&Arc<Editing>> {
+        self.inner.editing.as_ref()
+    }
+
+    /// The world being edited, when `id` is its planet.
+    pub(crate) fn editing_of(&self, id: PlanetId) -> Option<&Arc<Editing>> {
+        self.editing().filter(|e| e.id == id)
+    }
+
+    /// The planet `id` and its edit revision (0 for planets that are not edited), built (off the
+    /// async runtime) when it is not held.
+    pub(crate) async fn planet(&self, id: PlanetId) -> Result<(Arc<Planet>, u64), String> {
+        if let Some(e) = self.editing_of(id) {
+            let c = e.current();
+            return Ok((c.planet, c.revision));
+        }
+        self.plain_planet(id).await.map(|p| (p, 0))
+    }
+
+    async fn plain_planet(&self, id: PlanetId) -> Result<Arc<Planet>, String> {
         if let Some(p) = self.inner.planets.get(id) {
             return Ok(p);
         }
@@ -101,8 +167,90 @@ impl AppState {
         Ok(planet)
     }
 
-    /// The encoded chunk `id` of `planet`.
-    pub(crate) async fn chunk(&self, planet: Arc<Planet>, id: ChunkId) -> Result<Bytes, ChunkError> {
-        self.inner.generator.chunk(planet, id).await
+    /// The encoded chunk `id`, meshed from the current version of its planet.
+    pub(crate) async fn chunk(&self, id: ChunkId) -> Result<Bytes, ChunkError> {
+        // An edit between taking the planet and asking the generator makes the planet stale for
+        // the chunks it changed; take the new one and ask again (edits are rate-limited, so this
+        // ends).
+        loop {
+            let (planet, revision) = self.planet(id.planet).await.map_err(|e| ChunkError::Failed(e.into()))?;
+            match self.inner.generator.chunk(planet, revision, id).await {
+                Err(ChunkError::Stale) => continue,
+                other => return other,
+            }
+        }
+    }
+
+    /// The navigation grid of planet `id` (its current version) for `agent`, with the planet and
+    /// its revision: the world's default-agent grid (kept up to date edit by edit), a recently
+    /// used one, or a new one built off the async runtime.
+    pub(crate) async fn nav_grid(
+        &self,
+        id: PlanetId,
+        agent: Agent,
+    ) -> Result<(Arc<NavGrid>, Arc<Planet>, u64), String> {
+        let (planet, revision) = self.planet(id).await?;
+        let world = self.editing_of(id).filter(|_| agent == Agent::default()).cloned();
+        if let Some(g) = world.as_ref().and_then(|e| e.nav_grid(revision)) {
+            return Ok((g, planet, revision));
+        }
+        let key = agent_key(&agent);
+        {
+            let mut navs = self.inner.navs.lock().unwrap_or_else(PoisonError::into_inner);
+            if let Some(at) = navs
+                .iter()
+                .position(|e| e.planet == id && e.revision == revision && e.agent == key)
+            {
+                let e = navs.remove(at).expect("found above");
+                let g = Arc::clone(&e.grid);
+                navs.push_back(e);
+                return Ok((g, planet, revision));
+            }
+        }
+        let p = Arc::clone(&planet);
+        let grid = tokio::task::spawn_blocking(move || NavGrid::build(p.density().as_ref(), p.layout(), agent))
+            .await
+            .map_err(|e| format!("building the navigation grid failed: {e}"))?
+            .map_err(|e| e.to_string())?;
+        let grid = Arc::new(grid);
+        match world {
+            Some(e) => e.keep_nav_grid(revision, Arc::clone(&grid)),
+            None => {
+                let mut navs = self.inner.navs.lock().unwrap_or_else(PoisonError::into_inner);
+                navs.retain(|e| !(e.planet == id && e.agent == key));
+                navs.push_back(NavEntry {
+                    planet: id,
+                    revision,
+                    agent: key,
+                    grid: Arc::clone(&grid),
+                });
+                while navs.len() > MAX_NAV_GRIDS {
+                    navs.pop_front();
+                }
+            }
+        }
+        Ok((grid, planet, revision))
+    }
+
+    /// Performs an edit action on the world (off the async runtime).
+    pub(crate) async fn edit(&self, editing: Arc<Editing>, action: Action) -> Result<Outcome, String> {
+        let generator = Arc::clone(&self.inner.generator);
+        tokio::task::spawn_blocking(move || editing.perform(action, &generator))
+            .await
+            .map_err(|e| format!("the edit task failed: {e}"))?
+            .map_err(|e| e.to_string())
+    }
+
+    /// Takes edits made to the world file by other programs (off the async runtime); returns
+    /// whether there were any.
+    pub async fn sync_world(&self) -> Result<bool, String> {
+        let Some(editing) = self.editing().cloned() else {
+            return Ok(false);
+        };
+        let generator = Arc::clone(&self.inner.generator);
+        tokio::task::spawn_blocking(move || editing.sync(&generator))
+            .await
+            .map_err(|e| format!("the world check failed: {e}"))?
+            .map_err(|e| e.to_string())
     }
 }

@@ -243,6 +243,16 @@ impl World {
         Ok(n.unsigned_abs())
     }
 
+    /// SQLite's `PRAGMA data_version` of this connection: it changes when another connection
+    /// (another program, or another `World` on the same file) commits a change to the file, and
+    /// stays the same for this world's own changes. A long-lived reader polls it to notice edits
+    /// made by others, then reads the edits again.
+    pub fn data_version(&self) -> Result<i64> {
+        self.conn
+            .query_row("PRAGMA data_version", [], |r| r.get(0))
+            .map_err(|e| sqlite(&self.path, e))
+    }
+
     /// Runs SQLite's full `PRAGMA integrity_check`; `Ok` when it answers "ok", else
     /// [`WorldError::Corrupt`] with its first findings.
     pub fn integrity_check(&self) -> Result<()> {

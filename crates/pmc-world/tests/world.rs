@@ -583,3 +583,25 @@ fn integrity_check_passes_after_normal_use_and_two_handles_share_a_world() {
     w.integrity_check().unwrap();
     assert!(!Path::new(&format!("{}-journal", p.display())).exists());
 }
+
+#[test]
+fn data_version_changes_only_for_changes_by_other_handles() {
+    let d = dir("data-version");
+    let (p, mut a) = new_world(&d);
+    let mut b = World::open(&p).unwrap();
+    let v0 = a.data_version().unwrap();
+    a.append(&op(BrushKind::Add, 0.0, 0.0, 201.0, 2.0, 1.0)).unwrap();
+    assert_eq!(
+        a.data_version().unwrap(),
+        v0,
+        "a's own commit does not change a's data_version"
+    );
+    let b0 = b.data_version().unwrap();
+    assert_eq!(b.data_version().unwrap(), b0, "reading does not change it");
+    b.undo().unwrap();
+    assert_ne!(a.data_version().unwrap(), v0, "b's commit is seen by a");
+    let v1 = a.data_version().unwrap();
+    assert_eq!(a.data_version().unwrap(), v1, "stable without further commits");
+    b.redo().unwrap();
+    assert_ne!(a.data_version().unwrap(), v1);
+}

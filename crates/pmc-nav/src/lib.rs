@@ -1,0 +1,36 @@
+//! Navigation on planetary marching cubes (seed 000 Sec. 4.5): a navigation grid of surface
+//! voxels over the whole planet, with the overhang and cave checks of Fig. 11, connected
+//! components (Fig. 10), and A* paths with a great-circle heuristic.
+//!
+//! - [`Columns`]: every voxel column of the planet and its neighbours across chunk borders, face
+//!   edges and cube corners.
+//! - [`NavGrid`]: surface voxels (every floor of a column, so cave floors too), the steps an
+//!   [`Agent`] can take between them, and components; rebuilt per tile after an edit.
+//! - [`find_path`]: the shortest walk between two nodes, or [`NoPath`] (an answer, not an error).
+//!
+//! ```
+//! use pmc_density::Sphere;
+//! use pmc_geometry::{glam::DVec3, Layout};
+//! use pmc_nav::{find_path, Agent, NavGrid};
+//! let layout = Layout::new(2, 8, 100.0, 2.0, 1).unwrap();
+//! let grid = NavGrid::build(&Sphere { radius: 110.0 }, &layout, Agent::default()).unwrap();
+//! let a = grid.node_near(DVec3::Y, None, 0).unwrap();
+//! let b = grid.node_near(DVec3::X, None, 0).unwrap();
+//! let path = find_path(&grid, a, b).unwrap();
+//! // A quarter of a great circle at radius about 110 m.
+//! assert!((path.length - 110.0 * std::f64::consts::FRAC_PI_2).abs() < 10.0);
+//! ```
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+mod agent;
+mod columns;
+mod grid;
+mod report;
+mod search;
+
+pub use agent::{Agent, AgentError};
+pub use columns::{ColumnPlace, Columns, Neighbours};
+pub use grid::{NavError, NavGrid, Node, NodeId, Step, TileKey, MAX_COLUMNS};
+pub use report::{path_geojson, path_json, query, waypoint, End, PathAnswer, PATH_FORMAT, PATH_VERSION};
+pub use search::{find_path, NoPath, Path};

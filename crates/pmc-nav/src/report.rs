@@ -1,0 +1,153 @@
+//! Paths as documents: the JSON and GeoJSON of `docs/specs/path-v1.md`, written by `pmc path`
+//! and the server's `/api/v1/path`.
+
+use crate::grid::NavGrid;
+use crate::search::{NoPath, Path};
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::LatLon;
+use serde_json::{json, Value};
+
+/// The format name in the JSON document.
+pub const PATH_FORMAT: &str = "pmc-path";
+/// The format version.
+pub const PATH_VERSION: u32 = 1;
+
+/// Degrees rounded to 1e-9 (about 0.1 mm on Earth): enough for any planet, and free of
+/// round-trip noise such as 29.999999999999996.
+fn degrees(x: f64) -> f64 {
+    (x * 1e9).round() / 1e9
+}
+
+/// Latitude, longitude (degrees) and altitude above `datum` (metres) of a point.
+pub fn waypoint(p: DVec3, datum: f64) -> Value {
+    let ll = LatLon::from_point(p).unwrap_or(LatLon { lat: 0.0, lon: 0.0 });
+    json!({ "lat": degrees(ll.lat), "lon": degrees(ll.lon), "alt": p.length() - datum })
+}
+
+/// One end of a path query: a direction from the planet centre and, optionally, the radius
+/// (metres from the centre) of the floor wanted; without it, the highest floor (the ground seen
+/// from above).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct End {
+    /// Direction from the planet centre (any non-zero length).
+    pub dir: DVec3,
+    /// Radius of the floor wanted.
+    pub radius: Option<f64>,
+}
+
+impl End {
+    fn json(&self, datum: f64) -> Value {
+        let ll = LatLon::from_point(self.dir).unwrap_or(LatLon { lat: 0.0, lon: 0.0 });
+        json!({ "lat": degrees(ll.lat), "lon": degrees(ll.lon), "alt": self.radius.map(|r| r - datum) })
+    }
+}
+
+/// What a path query found: a path, no path (with why), or no walkable ground near an end.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PathAnswer {
+    /// A path.
+    Found(Path),
+    /// Both ends are on the grid, and no path joins them.
+    NoPath(NoPath),
+    /// No node lies near the start (`true`) or the goal (`false`).
+    NoGround {
+        /// Whether it is the start.
+        start: bool,
+    },
+}
+
+impl PathAnswer {
+    /// Why there is no path, in words (`None` for a path).
+    pub fn reason(&self) -> Option<String> {
+        match self {
+            PathAnswer::Found(_) => None,
+            PathAnswer::NoPath(n) => Some(n.to_string()),
+            PathAnswer::NoGround { start } => Some(format!(
+                "no path: no walkable ground near the {} (every nearby column is rock to the top, or has no head room for the agent)",
+                if *start { "start" } else { "goal" }
+            )),
+        }
+    }
+}
+
+/// The JSON document of a path query from `from` to `to` (the points asked for, planet frame).
+pub fn path_json(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
+    let a = grid.agent();
+    let mut v = json!({
+        "format": PATH_FORMAT,
+        "version": PATH_VERSION,
+        "found": matches!(answer, PathAnswer::Found(_)),
+        "asked": { "from": from.json(datum), "to": to.json(datum) },
+        "agent": { "clearance": a.clearance, "step_up": a.step_up, "step_down": a.step_down, "max_slope": a.max_slope },
+        "grid": { "nodes": grid.node_count(), "components": grid.component_sizes().len() },
+    });
+    match answer {
+        PathAnswer::Found(p) => {
+            let w: Vec<Value> = p.points.iter().map(|q| waypoint(*q, datum)).collect();
+            v["length"] = json!(p.length);
+            v["steps"] = json!(p.nodes.len().saturating_sub(1));
+            v["component"] = json!(grid.component(p.nodes[0]));
+            v["waypoints"] = json!(w);
+            v["expanded"] = json!(p.expanded);
+        }
+        other => {
+            v["reason"] = json!(other.reason());
+            if let PathAnswer::NoPath(NoPath::DifferentComponents { from, to }) = other {
+                v["components"] = json!([from, to]);
+            }
+        }
+    }
+    v
+}
+
+/// The GeoJSON (RFC 7946) of a path query: a `FeatureCollection` holding the path as a
+/// `LineString` of `[lon, lat, alt]` (when found) and the two ends asked for as `Point`s
+/// (`[lon, lat]`, with the altitude when one was asked for).
+pub fn path_geojson(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
+    let coords = |p: DVec3| {
+        let w = waypoint(p, datum);
+        json!([w["lon"], w["lat"], w["alt"]])
+    };
+    let point = |e: End, role: &str| {
+        let w = e.json(datum);
+        let c = match e.radius {
+            Some(_) => json!([w["lon"], w["lat"], w["alt"]]),
+            None => json!([w["lon"], w["lat"]]),
+        };
+        json!({ "type": "Feature", "geometry": { "type": "Point", "coordinates": c }, "properties": { "role": role } })
+    };
+    let mut features = Vec::new();
+    if let PathAnswer::Found(p) = answer {
+        let line: Vec<Value> = p.points.iter().map(|q| coords(*q)).collect();
+        features.push(json!({
+            "type": "Feature",
+            "geometry": { "type": "LineString", "coordinates": line },
+            "properties": { "role": "path", "length": p.length, "steps": p.nodes.len().saturating_sub(1),
+                            "component": grid.component(p.nodes[0]) },
+        }));
+    }
+    features.push(point(from, "from"));
+    features.push(point(to, "to"));
+    json!({
+        "type": "FeatureCollection",
+        "features": features,
+        "properties": { "format": PATH_FORMAT, "version": PATH_VERSION, "found": matches!(answer, PathAnswer::Found(_)),
+                        "reason": answer.reason() },
+    })
+}
+
+/// Finds the path between the walkable ground nearest to `from` and `to`: each end is, in the
+/// nearest column with nodes within `max_rings` columns, the node nearest to the radius asked
+/// for, or the highest one.
+pub fn query(grid: &NavGrid, from: End, to: End, max_rings: usize) -> PathAnswer {
+    let Some(a) = grid.node_near(from.dir, from.radius, max_rings) else {
+        return PathAnswer::NoGround { start: true };
+    };
+    let Some(b) = grid.node_near(to.dir, to.radius, max_rings) else {
+        return PathAnswer::NoGround { start: false };
+    };
+    match crate::search::find_path(grid, a, b) {
+        Ok(p) => PathAnswer::Found(p),
+        Err(e) => PathAnswer::NoPath(e),
+    }
+}

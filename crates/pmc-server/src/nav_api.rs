@@ -1,0 +1,172 @@
+//! The navigation endpoints of `docs/specs/http-api-v1.md`: `GET /api/v1/path` (a walking path
+//! between two places, `docs/specs/path-v1.md`) and `GET /api/v1/navgrid` (the grid's nodes and
+//! steps near a point, with their components, for drawing).
+
+use crate::api::{ApiError, Params};
+use crate::AppState;
+use axum::extract::{RawQuery, State};
+use axum::http::{header, HeaderValue};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::LatLon;
+use pmc_nav::{path_geojson, path_json, query, Agent, End, NodeId};
+use serde_json::{json, Value};
+
+/// Columns searched around each end of a path for walkable ground.
+pub const SNAP_RINGS: usize = 8;
+/// Default and largest `limit` of `/navgrid`.
+pub const DEFAULT_NAV_LIMIT: usize = 20_000;
+/// Largest `limit` of `/navgrid`.
+pub const MAX_NAV_LIMIT: usize = 100_000;
+
+fn no_store(v: Value) -> Response {
+    let mut r = Json(v).into_response();
+    r.headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    r
+}
+
+/// The agent the query names: `clearance`, `step_up`, `step_down`, `max_slope`, each optional.
+fn agent(params: &Params) -> Result<Agent, ApiError> {
+    let d = Agent::default();
+    let mut a = d;
+    for (name, slot) in [
+        ("clearance", &mut a.clearance),
+        ("step_up", &mut a.step_up),
+        ("step_down", &mut a.step_down),
+        ("max_slope", &mut a.max_slope),
+    ] {
+        if params.get(name).is_some() {
+            *slot = params.finite(name)?;
+        }
+    }
+    a.validate().map_err(|e| ApiError::bad_request(e.to_string()))?;
+    Ok(a)
+}
+
+/// Parses `LAT,LON[,ALT]` of parameter `name` into a path end.
+fn end(params: &Params, name: &str, datum: f64) -> Result<End, ApiError> {
+    let raw = params
+        .get(name)
+        .ok_or_else(|| ApiError::bad_request(format!("missing query parameter '{name}' (LAT,LON or LAT,LON,ALT)")))?;
+    let bad = |why: String| {
+        ApiError::bad_request(format!(
+            "{name}={raw}: {why}; give LAT,LON or LAT,LON,ALT (degrees, metres)"
+        ))
+    };
+    let parts: Vec<&str> = raw.split(',').map(str::trim).collect();
+    if !(2..=3).contains(&parts.len()) {
+        return Err(bad(format!("expected 2 or 3 numbers, got {}", parts.len())));
+    }
+    let num = |t: &str| match t.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        _ => Err(bad(format!("'{t}' is not a finite number"))),
+    };
+    let (lat, lon) = (num(parts[0])?, num(parts[1])?);
+    let ll = LatLon::new(lat, lon).map_err(|e| bad(e.to_string()))?;
+    let radius = match parts.get(2) {
+        Some(t) => Some(datum + num(t)?),
+        None => None,
+    };
+    Ok(End {
+        dir: ll.to_unit(),
+        radius,
+    })
+}
+
+/// `GET /api/v1/path?from=LAT,LON[,ALT]&to=LAT,LON[,ALT]&format=json|geojson`.
+pub async fn path(State(state): State<AppState>, RawQuery(q): RawQuery) -> Result<Response, ApiError> {
+    let params = Params::parse(q);
+    let id = params.planet(&state)?;
+    let agent = agent(&params)?;
+    let geojson = match params.get("format") {
+        None | Some("json") => false,
+        Some("geojson") => true,
+        Some(other) => {
+            return Err(ApiError::bad_request(format!(
+                "format must be json or geojson, got '{other}'"
+            )))
+        }
+    };
+    // Checked before any grid is built.
+    let datum_probe = state.planet(id).await.map_err(ApiError::internal)?.0.datum_radius();
+    let (from, to) = (end(&params, "from", datum_probe)?, end(&params, "to", datum_probe)?);
+    let (grid, planet, revision) = state.nav_grid(id, agent).await.map_err(ApiError::internal)?;
+    let datum = planet.datum_radius();
+    let doc = tokio::task::spawn_blocking(move || {
+        let answer = query(&grid, from, to, SNAP_RINGS);
+        let mut doc = if geojson {
+            path_geojson(&grid, &answer, from, to, datum)
+        } else {
+            path_json(&grid, &answer, from, to, datum)
+        };
+        doc["revision"] = json!(revision);
+        doc
+    })
+    .await
+    .map_err(|e| ApiError::internal(format!("the path search failed: {e}")))?;
+    Ok(no_store(doc))
+}
+
+/// `GET /api/v1/navgrid?x=&y=&z=&range=&limit=`: nodes near a point with their components, and
+/// the steps between them.
+pub async fn navgrid(State(state): State<AppState>, RawQuery(q): RawQuery) -> Result<Response, ApiError> {
+    let params = Params::parse(q);
+    let id = params.planet(&state)?;
+    let agent = agent(&params)?;
+    let p = DVec3::new(params.finite("x")?, params.finite("y")?, params.finite("z")?);
+    let range = params.finite("range")?;
+    if range <= 0.0 {
+        return Err(ApiError::bad_request(format!(
+            "range must be above 0 metres, got {range}"
+        )));
+    }
+    let limit = match params.get("limit") {
+        None => DEFAULT_NAV_LIMIT,
+        Some(s) => match s.trim().parse::<usize>() {
+            Ok(n) if (1..=MAX_NAV_LIMIT).contains(&n) => n,
+            _ => {
+                return Err(ApiError::bad_request(format!(
+                    "limit must be an integer from 1 to {MAX_NAV_LIMIT}, got '{s}'"
+                )))
+            }
+        },
+    };
+    let (grid, _, revision) = state.nav_grid(id, agent).await.map_err(ApiError::internal)?;
+    let doc = tokio::task::spawn_blocking(move || {
+        let (nodes, truncated) = grid.nodes_near(p, range, limit);
+        let index: std::collections::HashMap<NodeId, usize> = nodes.iter().enumerate().map(|(i, n)| (*n, i)).collect();
+        let mut positions = Vec::with_capacity(nodes.len() * 3);
+        let mut components = Vec::with_capacity(nodes.len());
+        let mut edges = Vec::new();
+        for (i, n) in nodes.iter().enumerate() {
+            let q = grid.position(*n).unwrap_or(p) - p;
+            positions.extend([q.x, q.y, q.z]);
+            components.push(grid.component(*n).unwrap_or(u32::MAX));
+            for s in grid.steps(*n) {
+                if let Some(j) = index.get(&s.to).filter(|j| **j > i) {
+                    edges.extend([i as u32, *j as u32]);
+                }
+            }
+        }
+        let sizes: Vec<u32> = components
+            .iter()
+            .map(|c| grid.component_sizes().get(*c as usize).copied().unwrap_or(0))
+            .collect();
+        json!({
+            "revision": revision,
+            "origin": p.to_array(),
+            "positions": positions,
+            "components": components,
+            "component_sizes": sizes,
+            "edges": edges,
+            "truncated": truncated,
+            "total_nodes": grid.node_count(),
+            "total_components": grid.component_sizes().len(),
+        })
+    })
+    .await
+    .map_err(|e| ApiError::internal(format!("the grid query failed: {e}")))?;
+    Ok(no_store(doc))
+}

@@ -1,0 +1,170 @@
+//! The navigation endpoints: `/api/v1/path` and `/api/v1/navgrid`, on plain planets and on a
+//! world whose grid follows its edits.
+
+mod common;
+
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use common::{get, send, small_config, small_layout};
+use pmc_edit::{BrushKind, BrushOp};
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::LatLon;
+use pmc_nav::{query, Agent, End, NavGrid, PathAnswer};
+use pmc_planet::{Planet, PresetKind};
+use pmc_server::{router, AppState, ServerConfig};
+use serde_json::{json, Value};
+
+fn end(lat: f64, lon: f64) -> End {
+    End {
+        dir: LatLon::new(lat, lon).unwrap().to_unit(),
+        radius: None,
+    }
+}
+
+fn direct_length(planet: &Planet, from: End, to: End) -> f64 {
+    let g = NavGrid::build(planet.density().as_ref(), planet.layout(), Agent::default()).unwrap();
+    match query(&g, from, to, 8) {
+        PathAnswer::Found(p) => p.length,
+        other => panic!("{other:?}"),
+    }
+}
+
+#[tokio::test]
+async fn path_answers_the_shortest_walk_as_json_or_geojson() {
+    let a = router(AppState::new(small_config()).unwrap());
+    let r = get(&a, "/api/v1/path?from=10,10&to=12,40").await;
+    assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
+    let v = r.json();
+    assert_eq!(
+        (v["format"].as_str(), v["found"].as_bool()),
+        (Some("pmc-path"), Some(true)),
+        "{v}"
+    );
+    let planet = Planet::new(PresetKind::Earthlike, 3, small_layout());
+    assert_eq!(
+        v["length"].as_f64().unwrap(),
+        direct_length(&planet, end(10.0, 10.0), end(12.0, 40.0))
+    );
+    assert_eq!(v["revision"], 0);
+    let g = get(&a, "/api/v1/path?from=10,10&to=12,40&format=geojson").await.json();
+    assert_eq!(g["type"], "FeatureCollection");
+    assert_eq!(g["features"][0]["properties"]["length"], v["length"]);
+    // Another agent, another grid: one that cannot climb any slope finds nothing.
+    let v = get(
+        &a,
+        "/api/v1/path?from=10,10&to=12,40&max_slope=0.0001&step_up=0&step_down=0",
+    )
+    .await
+    .json();
+    assert_eq!(v["found"], false);
+    assert!(v["reason"].as_str().unwrap().contains("component"));
+}
+
+#[tokio::test]
+async fn bad_path_and_grid_queries_get_a_400() {
+    let a = router(AppState::new(small_config()).unwrap());
+    for (uri, needle) in [
+        ("/api/v1/path?to=1,1", "missing query parameter 'from'"),
+        ("/api/v1/path?from=1,1", "'to'"),
+        ("/api/v1/path?from=100,1&to=1,1", "latitude"),
+        ("/api/v1/path?from=1&to=1,1", "expected 2 or 3 numbers"),
+        ("/api/v1/path?from=1,NaN&to=1,1", "finite"),
+        ("/api/v1/path?from=1,1&to=1,1,inf", "finite"),
+        ("/api/v1/path?from=1,1&to=2,2&format=kml", "json or geojson"),
+        ("/api/v1/path?from=1,1&to=2,2&clearance=0", "clearance"),
+        ("/api/v1/path?from=1,1&to=2,2&max_slope=x", "max_slope"),
+        ("/api/v1/path?from=1,1&to=2,2&preset=venus", "unknown preset"),
+        ("/api/v1/navgrid?x=0&y=0&range=10", "'z'"),
+        ("/api/v1/navgrid?x=0&y=0&z=0&range=0", "range must be above 0"),
+        ("/api/v1/navgrid?x=0&y=0&z=0&range=5&limit=0", "limit"),
+        ("/api/v1/navgrid?x=0&y=0&z=0&range=5&limit=100001", "limit"),
+        ("/api/v1/navgrid?x=0&y=0&z=0&range=5&step_up=-2", "step"),
+    ] {
+        let r = get(&a, uri).await;
+        assert_eq!(r.status, StatusCode::BAD_REQUEST, "{uri}");
+        let msg = r.json()["error"].as_str().unwrap().to_string();
+        assert!(msg.contains(needle), "{uri}: '{needle}' not in '{msg}'");
+    }
+    let r = send(&a, Request::post("/api/v1/path").body(Body::empty()).unwrap()).await;
+    assert_eq!(r.status, StatusCode::METHOD_NOT_ALLOWED);
+}
+
+#[tokio::test]
+async fn navgrid_lists_the_nodes_near_a_point_with_components_and_steps() {
+    let a = router(AppState::new(small_config()).unwrap());
+    let planet = Planet::new(PresetKind::Earthlike, 3, small_layout());
+    let grid = NavGrid::build(planet.density().as_ref(), planet.layout(), Agent::default()).unwrap();
+    let p = LatLon::new(20.0, 30.0).unwrap().to_unit() * planet.datum_radius();
+    let uri = format!("/api/v1/navgrid?x={}&y={}&z={}&range=40", p.x, p.y, p.z);
+    let v = get(&a, &uri).await.json();
+    let (nodes, _) = grid.nodes_near(p, 40.0, usize::MAX);
+    let positions = v["positions"].as_array().unwrap();
+    assert_eq!(positions.len(), 3 * nodes.len());
+    assert!(!nodes.is_empty());
+    assert_eq!(v["truncated"], false);
+    assert_eq!(v["total_nodes"].as_u64().unwrap() as usize, grid.node_count());
+    for (i, n) in nodes.iter().enumerate() {
+        let q = grid.position(*n).unwrap() - p;
+        let got = DVec3::new(
+            positions[3 * i].as_f64().unwrap(),
+            positions[3 * i + 1].as_f64().unwrap(),
+            positions[3 * i + 2].as_f64().unwrap(),
+        );
+        assert!((got - q).length() < 1e-9);
+        assert_eq!(v["components"][i].as_u64(), grid.component(*n).map(u64::from));
+    }
+    let edges = v["edges"].as_array().unwrap();
+    assert!(!edges.is_empty() && edges.len() % 2 == 0);
+    for e in edges.chunks(2) {
+        let (i, j) = (e[0].as_u64().unwrap() as usize, e[1].as_u64().unwrap() as usize);
+        assert!(i < j && j < nodes.len());
+        assert!(grid.steps(nodes[i]).iter().any(|s| s.to == nodes[j]));
+    }
+    let v = get(&a, &format!("{uri}&limit=2")).await.json();
+    assert_eq!(
+        (v["positions"].as_array().unwrap().len(), v["truncated"].as_bool()),
+        (6, Some(true))
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_worlds_grid_follows_its_edits() {
+    let d = std::env::temp_dir().join(format!("pmc-server-nav-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let config = ServerConfig {
+        world: Some(d.join("w.pmcw")),
+        preset: PresetKind::Sphere,
+        ..small_config()
+    };
+    let a = router(AppState::new(config).unwrap());
+    let path = |v: &Value| v["length"].as_f64().unwrap();
+    let uri = "/api/v1/path?from=0,-20&to=0,20";
+    let before = get(&a, uri).await.json();
+    assert_eq!(before["found"], true);
+    // A deep pit with sheer walls across the way.
+    let planet = Planet::new(PresetKind::Sphere, 3, small_layout());
+    let c = LatLon::new(0.0, 0.0).unwrap().to_unit() * planet.datum_radius();
+    let op = BrushOp::new(BrushKind::Remove, c, 20.0, 1.0).unwrap();
+    let body = json!({"brush": "remove", "x": c.x, "y": c.y, "z": c.z, "radius": 20.0});
+    let req = Request::post("/api/v1/edits")
+        .header("content-type", "application/json")
+        .body(Body::from(body.to_string()))
+        .unwrap();
+    assert_eq!(send(&a, req).await.status, StatusCode::OK);
+    let after = get(&a, uri).await.json();
+    assert_eq!(after["revision"], 1);
+    let edited = planet.clone().with_edits(vec![op].into());
+    assert_eq!(path(&after), direct_length(&edited, end(0.0, -20.0), end(0.0, 20.0)));
+    assert!(
+        path(&after) > path(&before) + 1.0,
+        "{} -> {}",
+        path(&before),
+        path(&after)
+    );
+    // Undone: the first way again.
+    let req = Request::post("/api/v1/edits/undo").body(Body::empty()).unwrap();
+    assert_eq!(send(&a, req).await.status, StatusCode::OK);
+    let undone = get(&a, uri).await.json();
+    assert_eq!((undone["revision"].as_u64(), path(&undone)), (Some(2), path(&before)));
+}
