@@ -63,3 +63,16 @@ export function colourCount(img) {
   }
   return seen.size;
 }
+
+/** The `w` × `h` window of `img` centred on (cx, cy), clipped to the image. */
+export function crop(img, cx, cy, w, h) {
+  const x0 = Math.max(0, Math.round(cx - w / 2));
+  const y0 = Math.max(0, Math.round(cy - h / 2));
+  const x1 = Math.min(img.width, x0 + w);
+  const y1 = Math.min(img.height, y0 + h);
+  const out = { width: x1 - x0, height: y1 - y0, data: Buffer.alloc(4 * (x1 - x0) * (y1 - y0)) };
+  for (let y = y0; y < y1; y++) {
+    img.data.copy(out.data, 4 * (y - y0) * out.width, 4 * (y * img.width + x0), 4 * (y * img.width + x1));
+  }
+  return out;
+}

@@ -3,7 +3,8 @@
 //   npm run e2e                      (builds viewer/dist first)
 //
 // Environment:
-//   PMC_BIN         the pmc binary (default ../target/release/pmc, relative to viewer/)
+//   PMC_BIN         the pmc binary (relative to the working directory; default target/release/pmc
+//                   of the repository)
 //   CHROMIUM        the browser (default /usr/bin/chromium)
 //   PMC_E2E_MOCK=1  use e2e/mockServer.mjs (planets exported by `pmc generate`) instead of
 //                   `pmc serve`, for working on the viewer before the server exists
@@ -17,24 +18,36 @@
 import { spawn } from 'node:child_process';
 import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer, request as httpRequest } from 'node:http';
-import { createServer as createNetServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { dirname, extname, join, normalize, resolve, sep } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
-import { backgroundOf, colourCount, decodePng, fractionDifferent, fractionNot } from './images.mjs';
+import { backgroundOf, colourCount, crop, decodePng, fractionDifferent, fractionNot } from './images.mjs';
 import { startMockServer } from './mockServer.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const viewerDir = resolve(here, '..');
 const distDir = join(viewerDir, 'dist');
 const artifacts = join(here, 'artifacts');
-const PMC_BIN = resolve(viewerDir, process.env.PMC_BIN ?? '../target/release/pmc');
+// PMC_BIN is relative to the working directory; the default to the repository's target/
+const PMC_BIN = process.env.PMC_BIN ? resolve(process.env.PMC_BIN) : resolve(viewerDir, '../target/release/pmc');
 const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
 const USE_MOCK = process.env.PMC_E2E_MOCK === '1';
 const LAYOUT = { n_c: 4, n_t: 16 };
 const VIEWPORT = { width: 1024, height: 640 };
 const READY_MS = 240_000;
+/** The headless Chromium of every test: software WebGL, nothing from outside. */
+const CHROMIUM_ARGS = [
+  '--no-sandbox',
+  '--disable-gpu',
+  '--use-angle=swiftshader',
+  '--enable-unsafe-swiftshader',
+  '--disable-background-networking',
+  '--disable-component-update',
+  '--disable-sync',
+  '--no-first-run',
+  '--disable-quic',
+];
 const TOTAL_MS = 20 * 60_000;
 
 const started = Date.now();
@@ -74,17 +87,6 @@ function withTimeout(promise, ms, what) {
   ]);
 }
 
-function freePort() {
-  return new Promise((res, rej) => {
-    const s = createNetServer();
-    s.once('error', rej);
-    s.listen(0, '127.0.0.1', () => {
-      const { port } = s.address();
-      s.close(() => res(port));
-    });
-  });
-}
-
 async function fetchText(url, ms = 5000) {
   const res = await withTimeout(fetch(url), ms, `GET ${url}`);
   return { status: res.status, text: await res.text() };
@@ -105,8 +107,12 @@ async function run(cmd, args, ms) {
   );
 }
 
-/** Starts `pmc serve` on a free port with `layout` (null: the default layout); returns its base URL. */
-async function startPmcServe(layout) {
+/**
+ * Starts `pmc serve --port 0` with `layout` (null: the default layout) and, when given, `world`
+ * (a world file: editing on); reads the port from its "PMC viewer: URL" line. Returns its base URL
+ * and a `stop()` (also run at the end).
+ */
+async function startPmcServe(layout, { world = null } = {}) {
   if (!existsSync(PMC_BIN)) {
     throw new Error(`no pmc binary at ${PMC_BIN}: build it (cargo build --release --bin pmc) or set PMC_BIN`);
   }
@@ -117,12 +123,17 @@ async function startPmcServe(layout) {
         'Rebuild pmc with the server, or run the tests against the mock with PMC_E2E_MOCK=1.',
     );
   }
-  for (const flag of ['--port', '--n-c', '--n-t']) {
-    if (!help.out.includes(flag)) throw new Error(`\`pmc serve --help\` does not list ${flag}`);
+  for (const flag of ['--port', '--n-c', '--n-t', ...(world ? ['--world'] : [])]) {
+    if (!help.out.includes(flag)) {
+      throw new Error(
+        `\`pmc serve --help\` does not list ${flag}` +
+          (flag === '--world' ? ': this pmc has no editing API; rebuild it (cargo build --release -p pmc-cli)' : ''),
+      );
+    }
   }
-  const port = await freePort();
-  const args = ['serve', '--port', String(port)];
+  const args = ['serve', '--port', '0'];
   if (layout) args.push('--n-c', String(layout.n_c), '--n-t', String(layout.n_t));
+  if (world) args.push('--world', world);
   log(`starting ${PMC_BIN} ${args.join(' ')}`);
   const child = spawn(PMC_BIN, args, { stdio: ['ignore', 'pipe', 'pipe'] });
   let output = '';
@@ -130,28 +141,37 @@ async function startPmcServe(layout) {
   child.stderr.on('data', (d) => (output += d));
   let exited = null;
   child.on('exit', (code, signal) => (exited = { code, signal }));
-  cleanups.push(async () => {
+  const stop = async () => {
     if (exited) return;
     child.kill('SIGTERM');
     const t = setTimeout(() => child.kill('SIGKILL'), 3000);
-    await new Promise((r) => child.once('exit', r));
+    await new Promise((r) => (exited ? r() : child.once('exit', r)));
     clearTimeout(t);
-    log('pmc serve stopped');
-  });
-  const base = `http://127.0.0.1:${port}/`;
+    log(`pmc serve stopped${world ? ` (world ${world})` : ''}`);
+  };
+  cleanups.push(stop);
   const deadline = Date.now() + 60_000;
+  let base = null;
   for (;;) {
     if (exited) throw new Error(`pmc serve exited (${JSON.stringify(exited)}):\n${output}`);
-    try {
-      const h = await fetchText(`${base}api/v1/health`, 2000);
-      if (h.status === 200 && JSON.parse(h.text).ok === true) break;
-    } catch {
-      // not listening yet
+    if (!base) {
+      const m = /PMC viewer: (http:\/\/\S+)/.exec(output);
+      if (m) base = m[1].endsWith('/') ? m[1] : `${m[1]}/`;
     }
-    if (Date.now() > deadline) throw new Error(`pmc serve did not answer /api/v1/health within 60 s:\n${output}`);
+    if (base) {
+      try {
+        const h = await fetchText(`${base}api/v1/health`, 2000);
+        if (h.status === 200 && JSON.parse(h.text).ok === true) break;
+      } catch {
+        // not listening yet
+      }
+    }
+    if (Date.now() > deadline) {
+      throw new Error(`pmc serve did not ${base ? 'answer /api/v1/health' : 'print its "PMC viewer: URL" line'} within 60 s:\n${output}`);
+    }
     await new Promise((r) => setTimeout(r, 200));
   }
-  return base;
+  return { base, stop };
 }
 
 const MIME = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.css': 'text/css', '.png': 'image/png', '.svg': 'image/svg+xml', '.json': 'application/json' };
@@ -187,28 +207,48 @@ async function startFront(apiBase) {
     res.end(readFileSync(file));
   });
   await new Promise((r) => server.listen(0, '127.0.0.1', r));
-  cleanups.push(() => new Promise((r) => { server.closeAllConnections?.(); server.close(() => r()); }));
-  return `http://127.0.0.1:${server.address().port}/`;
+  let closed = false;
+  const stop = () =>
+    new Promise((r) => {
+      if (closed) return r();
+      closed = true;
+      server.closeAllConnections?.();
+      server.close(() => r());
+    });
+  cleanups.push(stop);
+  return { url: `http://127.0.0.1:${server.address().port}/`, stop };
 }
 
-/** Starts a server for `layout` (null: the default layout) and returns the URL to load the page from. */
-async function startBackend(layout) {
+/**
+ * Starts a server for `layout` (null: the default layout), editing `world` when given. Returns the
+ * URL to load the page from (`url`), the server's own (`api`) and `stop()`.
+ */
+async function startBackend(layout, { world = null } = {}) {
   const what = layout ? `n_c ${layout.n_c}, n_t ${layout.n_t}` : 'the default layout';
   if (USE_MOCK) {
+    if (world) throw new Error('the mock server has no editing API');
     log(`starting the mock server (${what}; planets from ${PMC_BIN} generate)`);
     const mock = await startMockServer({ pmcBin: PMC_BIN, layout: layout ?? { n_c: 8, n_t: 32 }, distDir });
     cleanups.push(() => mock.close());
-    return mock.url;
+    return { url: mock.url, api: mock.url, stop: async () => undefined };
   }
-  const apiBase = await startPmcServe(layout);
-  const embedded = await fetchText(apiBase);
+  const pmc = await startPmcServe(layout, { world });
+  const embedded = await fetchText(pmc.base);
   const fresh = readFileSync(join(distDir, 'index.html'), 'utf8');
   if (embedded.text === fresh || process.env.PMC_E2E_DIRECT === '1') {
     log(`testing the viewer embedded in pmc (${embedded.text === fresh ? 'same build as viewer/dist' : 'PMC_E2E_DIRECT=1'})`);
-    return apiBase;
+    return { url: pmc.base, api: pmc.base, stop: pmc.stop };
   }
   log('the viewer embedded in pmc differs from viewer/dist (rebuild pmc to embed it): serving viewer/dist in front of the real API');
-  return startFront(apiBase);
+  const front = await startFront(pmc.base);
+  return {
+    url: front.url,
+    api: pmc.base,
+    stop: async () => {
+      await front.stop();
+      await pmc.stop();
+    },
+  };
 }
 
 // ---- geometry for choosing views (same conventions as src/frames.ts) -------------------------
@@ -226,6 +266,9 @@ function headingPitchToward(lat, lon, radius, target) {
   const d = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
   return { heading: Math.atan2(d(f, east), d(f, north)) / DEG, pitch: Math.asin(d(f, up) / len) / DEG };
 }
+/** Latitude and longitude (degrees) of a planet-frame point. */
+const latLonOf = (p) => ({ lat: Math.atan2(p[1], Math.hypot(p[0], p[2])) / DEG, lon: Math.atan2(p[0], p[2]) / DEG });
+const distance = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
 
 // ---- the tests --------------------------------------------------------------------------------
 
@@ -260,7 +303,7 @@ async function main() {
   if (!existsSync(CHROMIUM)) throw new Error(`no browser at ${CHROMIUM} (install Debian's chromium or set CHROMIUM)`);
   mkdirSync(artifacts, { recursive: true });
 
-  const pageBase = await startBackend(LAYOUT);
+  const pageBase = (await startBackend(LAYOUT)).url;
 
   const profile = mkdtempSync(join(tmpdir(), 'pmc-e2e-chromium-'));
   cleanups.push(() => rmSync(profile, { recursive: true, force: true }));
@@ -271,17 +314,7 @@ async function main() {
       headless: true,
       viewport: VIEWPORT,
       deviceScaleFactor: 1,
-      args: [
-        '--no-sandbox',
-        '--disable-gpu',
-        '--use-angle=swiftshader',
-        '--enable-unsafe-swiftshader',
-        '--disable-background-networking',
-        '--disable-component-update',
-        '--disable-sync',
-        '--no-first-run',
-        '--disable-quic',
-      ],
+      args: CHROMIUM_ARGS,
     }),
     60_000,
     'launching Chromium',
@@ -296,40 +329,48 @@ async function main() {
   // Chromium's software compositor reads the WebGL canvas back to composite it, and the GL driver
   // says so as a console warning; it comes from the browser set-up, not from the page.
   const environmental = /GL Driver Message \(OpenGL, Performance, .*\): GPU stall due to ReadPixels/;
-  page.on('console', (m) => {
-    if (m.type() !== 'error' && m.type() !== 'warning') return;
-    if (environmental.test(m.text())) return;
-    if (expectedFailures.some((re) => re.test(m.location()?.url ?? ''))) return;
-    consoleProblems.push(`${m.type()}: ${m.text()}`);
-  });
-  page.on('pageerror', (e) => consoleProblems.push(`uncaught: ${e.message}`));
+  const failedResponses = [];
+  /** Collects console errors and warnings, uncaught errors and failed responses of `p`. */
+  const watchPage = (p, label = '') => {
+    const tag = label ? `[${label}] ` : '';
+    p.on('console', (m) => {
+      if (m.type() !== 'error' && m.type() !== 'warning') return;
+      if (environmental.test(m.text())) return;
+      if (expectedFailures.some((re) => re.test(m.location()?.url ?? ''))) return;
+      consoleProblems.push(`${tag}${m.type()}: ${m.text()}`);
+    });
+    p.on('pageerror', (e) => consoleProblems.push(`${tag}uncaught: ${e.message}`));
+    p.on('response', (r) => {
+      if (r.status() >= 400 && !expectedFailures.some((re) => re.test(r.url()))) failedResponses.push(`${tag}${r.status()} ${r.url()}`);
+    });
+  };
+  watchPage(page);
   const chunkRequests = [];
   page.on('request', (r) => {
     if (r.url().includes('/api/v1/chunk/')) chunkRequests.push(r.url());
   });
-  const failedResponses = [];
-  page.on('response', (r) => {
-    if (r.status() >= 400 && !expectedFailures.some((re) => re.test(r.url()))) failedResponses.push(`${r.status()} ${r.url()}`);
-  });
 
-  const hook = (fn, arg) => withTimeout(page.evaluate(fn, arg), READY_MS + 10_000, 'page.evaluate');
-  const ready = async (what) => {
+  const hookOn = (p) => (fn, arg) => withTimeout(p.evaluate(fn, arg), READY_MS + 10_000, 'page.evaluate');
+  const hook = hookOn(page);
+  const readyOn = async (p, what) => {
     const t0 = Date.now();
-    await hook((ms) => window.__pmc.ready(ms), READY_MS);
-    const s = await hook(() => window.__pmc.stats());
+    await hookOn(p)((ms) => window.__pmc.ready(ms), READY_MS);
+    const s = await hookOn(p)(() => window.__pmc.stats());
     log(`  ready ${what}: ${s.loaded} chunks, ${s.triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s`);
     return s;
   };
-  /** A screenshot of the view alone (panels hidden), saved under e2e/artifacts. */
-  const shot = async (name) => {
-    await page.addStyleTag({ content: '.panel, #loading, #error { visibility: hidden !important; }' }).then((h) => h.evaluate((el) => el.setAttribute('id', 'e2e-hide')));
+  const ready = (what) => readyOn(page, what);
+  /** A screenshot of the view of `p` alone (panels hidden), saved under e2e/artifacts. */
+  const shotOf = async (p, name) => {
+    await p.addStyleTag({ content: '.panel, #loading, #error { visibility: hidden !important; }' }).then((h) => h.evaluate((el) => el.setAttribute('id', 'e2e-hide')));
     // two more frames so the last chunks are on screen
-    await hook(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(() => r()))));
-    const buf = await page.screenshot({ type: 'png', timeout: 60_000 });
-    await page.evaluate(() => document.getElementById('e2e-hide')?.remove());
+    await hookOn(p)(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(() => r()))));
+    const buf = await p.screenshot({ type: 'png', timeout: 60_000 });
+    await p.evaluate(() => document.getElementById('e2e-hide')?.remove());
     writeFileSync(join(artifacts, `${name}.png`), buf);
     return decodePng(buf);
   };
+  const shot = (name) => shotOf(page, name);
 
   let orbitImg;
   let orbitStats;
@@ -340,6 +381,11 @@ async function main() {
     orbitStats = await ready('from orbit');
     check(orbitStats.preset === 'earthlike' && orbitStats.seed === '7', `planet is ${orbitStats.preset}/${orbitStats.seed}`);
     check(orbitStats.error === null, `the page shows an error: ${orbitStats.error}`);
+    // a server without a world: the tools are off and say why
+    check(await page.isDisabled('#tool-dig'), 'the Dig tool is enabled on a server without a world');
+    const why = await page.textContent('#tools-status');
+    check(/^Editing is off: /.test(why ?? ''), `the tools panel does not say why editing is off: "${why}"`);
+    log(`  tools: ${why}`);
     check(consoleProblems.length === 0, `console messages:\n  ${consoleProblems.join('\n  ')}`);
     check(failedResponses.length === 0, `failed responses:\n  ${failedResponses.join('\n  ')}`);
   });
@@ -451,7 +497,7 @@ async function main() {
   await step('5. close-up of mountains with caves and overhangs (earthlike seed 7, default layout)', async () => {
     // the README's close-up (`pmc render --lat 3 --lon 9 --distance 2250 --look-at=-10,8`) on the
     // default planet, from its own server: the small e2e planet is too coarse for caves
-    const base = await startBackend(null);
+    const base = (await startBackend(null)).url;
     await page.goto(`${base}#preset=earthlike&seed=7&mode=fly`, { waitUntil: 'load', timeout: 60_000 });
     await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
     const planet = await hook(() => fetch('api/v1/planet?preset=earthlike&seed=7').then((r) => r.json()));
@@ -466,6 +512,200 @@ async function main() {
     const frac = fractionNot(img, backgroundOf(img));
     log(`  ${s.loaded} chunks, ${s.triangles} triangles, ${(100 * frac).toFixed(1)} % not background, ${colourCount(img)} colours`);
     check(frac > 0.3, `the close-up is mostly background (${(100 * frac).toFixed(1)} %)`);
+    check(consoleProblems.length === 0, `console messages:\n  ${consoleProblems.join('\n  ')}`);
+    check(failedResponses.length === 0, `failed responses:\n  ${failedResponses.join('\n  ')}`);
+  });
+
+  if (USE_MOCK) {
+    log('7. editing needs the real `pmc serve --world` (the mock has no editing API): not run with PMC_E2E_MOCK=1');
+    return;
+  }
+
+  await step('7. editing: dig with the mouse, a second browser follows, undo/redo, reload, restart', async () => {
+    // the first browser's page is done: stop it drawing (software rendering shares the CPU)
+    await page.goto('about:blank');
+    // a fresh world on a server of its own (the default layout: voxels ~12 m wide, 4 m tall)
+    const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-world-'));
+    cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
+    const world = join(dir, 'e2e.pmcw');
+    let server = await startBackend(null, { world });
+    const apiGet = async (path) => {
+      const r = await fetchText(`${server.api}api/v1/${path}`, 10_000);
+      check(r.status === 200, `GET /api/v1/${path}: ${r.status} ${r.text}`);
+      return JSON.parse(r.text);
+    };
+    const planet = await apiGet('planet');
+    check(planet.edit?.enabled === true, `/api/v1/planet says editing is off: ${JSON.stringify(planet.edit)}`);
+    check(existsSync(world), `the server did not create the world file ${world}`);
+
+    // two browsers, each with its own context (own cookies, connections, event stream)
+    const browser = await withTimeout(
+      chromium.launch({ executablePath: CHROMIUM, headless: true, args: CHROMIUM_ARGS }),
+      60_000,
+      'launching a second Chromium',
+    );
+    cleanups.push(() => browser.close());
+    const ctxA = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1 });
+    const ctxB = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1 });
+    const A = await ctxA.newPage();
+    const B = await ctxB.newPage();
+    for (const [p, label] of [[A, 'A'], [B, 'B']]) {
+      p.setDefaultTimeout(60_000);
+      watchPage(p, label);
+    }
+    const hA = hookOn(A);
+    const hB = hookOn(B);
+    const CX = VIEWPORT.width / 2;
+    const CY = VIEWPORT.height / 2;
+    const pickAt = (h) => h(([x, y]) => window.__pmc.pick(x, y), [CX, CY]);
+    const statsOf = (h) => h(() => window.__pmc.stats());
+    const waitRevision = (p, revision) =>
+      p.waitForFunction(
+        (r) => {
+          const e = window.__pmc.stats().edit;
+          return e.revision === r && !e.inFlight;
+        },
+        revision,
+        { timeout: 60_000 },
+      );
+    const open = async (p, url, what) => {
+      await p.goto(url, { waitUntil: 'load', timeout: 60_000 });
+      await p.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+      return readyOn(p, what);
+    };
+    const WINDOW = 240; // pixels around the click compared between screenshots
+    const windowDiff = (a, b) => fractionDifferent(crop(a, CX, CY, WINDOW, WINDOW), crop(b, CX, CY, WINDOW, WINDOW));
+
+    // both open the page 200 m above (-10°, 8°); A finds the ground there, and the close-up view,
+    // 80 m above it looking down at 60°, goes into both pages' URL hash
+    const start = `${server.url}#preset=earthlike&seed=7&mode=fly&lat=-10&lon=8&alt=200&heading=0&pitch=-89`;
+    await Promise.all([open(A, start, 'A from 200 m'), open(B, start, 'B from 200 m')]);
+    // (200 px right of the centre: a snowfield, where the dug rock shows well)
+    const ground = await hA(([x, y]) => window.__pmc.pick(x, y), [CX + 200, CY]);
+    check(ground !== null, 'no terrain in the view from 200 m above (-10°, 8°)');
+    const groundAlt = Math.hypot(...ground.point) - planet.sea_radius;
+    check(groundAlt > 5, `the ground chosen near (-10°, 8°) is not land: ${groundAlt.toFixed(1)} m above the sea`);
+    const at = latLonOf(ground.point);
+    const viewHash =
+      `#preset=earthlike&seed=7&mode=fly&lat=${at.lat.toFixed(5)}&lon=${at.lon.toFixed(5)}` +
+      `&alt=${(groundAlt + 80).toFixed(1)}&heading=0&pitch=-60`;
+    log(`  view ${viewHash}`);
+    await Promise.all([A, B].map((p) => p.evaluate((h) => (location.hash = h), viewHash)));
+    const [sA0, sB0] = await Promise.all([readyOn(A, 'A at the close-up'), readyOn(B, 'B at the close-up')]);
+    for (const p of [A, B]) {
+      const h = await p.evaluate(() => location.hash);
+      check(h === viewHash, `the URL hash changed to ${h}`);
+    }
+    for (const [p, s0, label] of [[A, sA0, 'A'], [B, sB0, 'B']]) {
+      check(s0.edit.enabled && s0.edit.error === null, `${label}: editing is off or failed: ${JSON.stringify(s0.edit)}`);
+      await p.waitForFunction(() => window.__pmc.stats().edit.push === 'open', null, { timeout: 30_000 });
+    }
+    check(await A.isDisabled('#tool-dig') === false, 'the Dig button is disabled on an editable world');
+    const rev0 = sA0.edit.revision;
+    const pickA0 = await pickAt(hA);
+    const pickB0 = await pickAt(hB);
+    check(pickA0 !== null && pickB0 !== null, 'no terrain under the centre of the close-up');
+    check(Math.abs(pickA0.distance - pickB0.distance) < 0.05, `A and B do not show the same view: ${pickA0.distance} vs ${pickB0.distance} m`);
+    check(pickA0.distance < 120, `the terrain under the cursor is ${pickA0.distance.toFixed(1)} m away: not a close-up`);
+    log(`  before: terrain ${pickA0.distance.toFixed(2)} m from the camera (chunk ${pickA0.key}), revision ${rev0}`);
+    const beforeA = await shotOf(A, 'edit-before');
+
+    // A: Dig with the mouse, radius 16 m, one click at the centre
+    await A.click('#tool-dig');
+    check((await A.getAttribute('#tool-dig', 'aria-pressed')) === 'true', 'the Dig button is not shown as pressed');
+    await A.fill('#brush-radius', '16');
+    await A.press('#brush-radius', 'Enter');
+    let sA = await statsOf(hA);
+    check(sA.edit.tool === 'dig' && sA.edit.settings.radius === 16, `tool ${sA.edit.tool}, radius ${sA.edit.settings.radius} (wanted dig, 16)`);
+    await A.mouse.move(CX - 40, CY - 40);
+    await A.mouse.move(CX, CY, { steps: 4 });
+    await A.waitForFunction(() => window.__pmc.stats().cursor, null, { timeout: 10_000 });
+    await A.mouse.click(CX, CY);
+    await waitRevision(A, rev0 + 1);
+    sA = await statsOf(hA);
+    check(sA.edit.error === null, `the dig failed: ${sA.edit.error}`);
+    check(sA.edit.sent === 1, `${sA.edit.sent} edits sent for one click`);
+    await A.waitForFunction((r) => document.getElementById('s-edits')?.textContent?.startsWith(`rev ${r} · 1 active`), rev0 + 1, { timeout: 10_000 });
+    const list1 = await apiGet('edits');
+    check(
+      list1.edits.length === 1 && list1.active === 1 && list1.edits[0].active && list1.edits[0].brush === 'remove' && list1.edits[0].radius === 16,
+      `GET /api/v1/edits after the dig: ${JSON.stringify(list1)}`,
+    );
+    const dug = distance(list1.edits[0].center, pickA0.point);
+    check(dug < 0.5, `the edit is ${dug.toFixed(2)} m from the point clicked`);
+    // Look again (no brush cursor in the pictures), then let the edited chunks arrive
+    await A.click('#tool-look');
+    await A.waitForFunction(() => !window.__pmc.stats().cursor, null, { timeout: 10_000 });
+    await readyOn(A, 'A after the dig');
+    const pickA1 = await pickAt(hA);
+    check(pickA1 !== null, 'no terrain under the centre after the dig');
+    log(`  after the dig: ${pickA1.distance.toFixed(2)} m (${(pickA1.distance - pickA0.distance).toFixed(2)} m deeper), ${sA.reloads} chunk reloads in A`);
+    check(pickA1.distance > pickA0.distance + 4, `A: no hole under the cursor (${pickA0.distance.toFixed(2)} -> ${pickA1.distance.toFixed(2)} m)`);
+    const afterA = await shotOf(A, 'edit-after');
+    const dA = windowDiff(beforeA, afterA);
+    log(`  A: ${(100 * dA).toFixed(1)} % of the ${WINDOW} px window around the click changed`);
+    check(dA > 0.15, `A: only ${(100 * dA).toFixed(1)} % of the pixels around the click changed`);
+
+    // B saw it by itself (server push, then a reload of the edited chunks)
+    await waitRevision(B, rev0 + 1);
+    await readyOn(B, 'B after the push');
+    const sB1 = await statsOf(hB);
+    const pickB1 = await pickAt(hB);
+    check(sB1.reloads > 0, 'B reloaded no chunk after the push');
+    check(pickB1 !== null && Math.abs(pickB1.distance - pickA1.distance) < 0.05, `B does not show the hole: ${pickB1?.distance} m vs A ${pickA1.distance} m`);
+    const afterB = await shotOf(B, 'edit-page-b');
+    const dB = windowDiff(beforeA, afterB); // the same view as A's before the dig
+    log(`  B: ${sB1.reloads} chunk reloads, ${(100 * dB).toFixed(1)} % of the window changed`);
+    check(dB > 0.15, `B: only ${(100 * dB).toFixed(1)} % of the pixels around the hole changed`);
+
+    // undo with the button: the ground comes back, in A and in B
+    await A.click('#undo');
+    await waitRevision(A, rev0 + 2);
+    await readyOn(A, 'A after undo');
+    const pickA2 = await pickAt(hA);
+    check(pickA2 !== null && Math.abs(pickA2.distance - pickA0.distance) < 0.05, `undo did not restore the ground: ${pickA2?.distance} m, before the dig ${pickA0.distance} m`);
+    await waitRevision(B, rev0 + 2);
+    await readyOn(B, 'B after undo');
+    const pickB2 = await pickAt(hB);
+    check(pickB2 !== null && Math.abs(pickB2.distance - pickB0.distance) < 0.05, `B did not follow the undo: ${pickB2?.distance} m vs ${pickB0.distance} m`);
+    check((await apiGet('edits')).active === 0, 'the server still lists an active edit after undo');
+
+    // redo with Ctrl+Shift+Z: the hole is back
+    await A.keyboard.press('Control+Shift+Z');
+    await waitRevision(A, rev0 + 3);
+    await readyOn(A, 'A after redo');
+    const pickA3 = await pickAt(hA);
+    check(pickA3 !== null && Math.abs(pickA3.distance - pickA1.distance) < 0.05, `redo did not bring the hole back: ${pickA3?.distance} m vs ${pickA1.distance} m`);
+    const list3 = await apiGet('edits');
+    check(list3.revision === rev0 + 3 && list3.active === 1 && list3.redo === 0, `GET /api/v1/edits after redo: ${JSON.stringify(list3)}`);
+    await waitRevision(B, rev0 + 3);
+    await ctxB.close(); // B is done: A reloads faster alone
+
+    // a reload of A still shows it
+    await A.reload({ waitUntil: 'load' });
+    await A.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+    await readyOn(A, 'A reloaded');
+    const pickA4 = await pickAt(hA);
+    check(pickA4 !== null && Math.abs(pickA4.distance - pickA1.distance) < 0.05, `after a reload: ${pickA4?.distance} m, the hole was ${pickA1.distance} m`);
+    const reloadedA = await shotOf(A, 'edit-reloaded');
+    const dR = windowDiff(beforeA, reloadedA);
+    check(dR > 0.15, `after a reload only ${(100 * dR).toFixed(1)} % of the pixels around the hole differ from before the dig`);
+
+    // a new server on the same world file still has it (the edit was saved)
+    await A.goto('about:blank');
+    await server.stop();
+    server = await startBackend(null, { world });
+    const list5 = await apiGet('edits');
+    check(list5.active === 1 && distance(list5.edits[0].center, list1.edits[0].center) < 1e-6, `the restarted server lists ${JSON.stringify(list5)}`);
+    const s5 = await open(A, server.url + viewHash, 'A on the restarted server');
+    check(s5.edit.enabled, `editing is off after the restart: ${s5.edit.reason}`);
+    const pickA5 = await pickAt(hA);
+    check(pickA5 !== null && Math.abs(pickA5.distance - pickA1.distance) < 0.05, `after the restart: ${pickA5?.distance} m, the hole was ${pickA1.distance} m`);
+    const restarted = await shotOf(A, 'edit-restarted');
+    const dS = windowDiff(beforeA, restarted);
+    log(`  reload: ${(100 * dR).toFixed(1)} %, restart: ${(100 * dS).toFixed(1)} % of the window differ from before the dig`);
+    check(dS > 0.15, `after the restart only ${(100 * dS).toFixed(1)} % of the pixels around the hole differ from before the dig`);
+    await ctxA.close();
     check(consoleProblems.length === 0, `console messages:\n  ${consoleProblems.join('\n  ')}`);
     check(failedResponses.length === 0, `failed responses:\n  ${failedResponses.join('\n  ')}`);
   });

@@ -45,6 +45,79 @@ export interface PlanetInfo {
   faces: FaceInfo[];
   materials: string[];
   palette: { a: Vec3Tuple; b: Vec3Tuple };
+  /** Editing (absent from servers older than the editing API: treated as disabled). */
+  edit?: EditInfo;
+}
+
+/** The brushes of `POST /edits`. */
+export type BrushName = 'add' | 'remove' | 'smooth' | 'flatten' | 'paint';
+export const BRUSH_NAMES: readonly BrushName[] = ['add', 'remove', 'smooth', 'flatten', 'paint'];
+
+/** `/planet`'s `edit` object when the planet shown can be edited. */
+export interface EditEnabled {
+  enabled: true;
+  /** The world file's name. */
+  world: string;
+  revision: number;
+  active: number;
+  redo: number;
+  min_brush_radius: number;
+  max_brush_radius: number;
+  rate_per_second: number;
+  burst: number;
+  brushes: string[];
+}
+
+/** `/planet`'s `edit` object when editing is off, with the reason. */
+export interface EditDisabled {
+  enabled: false;
+  reason: string;
+  brushes?: string[];
+}
+
+export type EditInfo = EditEnabled | EditDisabled;
+
+/** The body of `POST /api/v1/edits`. */
+export interface EditRequest {
+  brush: BrushName;
+  /** Brush centre, planet frame, metres. */
+  x: number;
+  y: number;
+  z: number;
+  radius: number;
+  /** In (0, 1]; the server's default is 1. */
+  strength?: number;
+  /** Paint only (required there): a name of `/planet`'s `materials` or its index. */
+  material?: string | number;
+}
+
+/** The answer of `POST /edits`, `/edits/undo` and `/edits/redo`. */
+export interface EditAnswer {
+  /** The edit applied, undone or redone; null when there was nothing to undo or redo. */
+  id: number | null;
+  revision: number;
+  active: number;
+  redo: number;
+  /** Keys of every level-0 chunk whose mesh may have changed. */
+  chunks: string[];
+}
+
+export interface EditRecord {
+  id: number;
+  brush: BrushName;
+  center: Vec3Tuple;
+  radius: number;
+  strength: number;
+  /** The paint material's index, else null. */
+  material: number | null;
+  active: boolean;
+}
+
+export interface EditList {
+  revision: number;
+  active: number;
+  redo: number;
+  edits: EditRecord[];
 }
 
 export interface ChunkEntry {
@@ -75,8 +148,10 @@ export class ApiError extends Error {
     message: string,
     readonly status: number,
     readonly url: string,
-    /** Seconds from a `Retry-After` header (503), when given. */
+    /** Seconds from a `Retry-After` header (503, 429), when given. */
     readonly retryAfter: number | null = null,
+    /** The server's own message (the JSON `error` member), when it sent one. */
+    readonly serverMessage: string | null = null,
   ) {
     super(message);
     this.name = 'ApiError';
@@ -84,6 +159,10 @@ export class ApiError extends Error {
   /** True when retrying later may succeed (busy server, network trouble). */
   get transient(): boolean {
     return this.status === 0 || this.status === 503 || this.status === 502 || this.status === 504;
+  }
+  /** True for 429: too many edits from this client; wait `retryAfter` seconds. */
+  get rateLimited(): boolean {
+    return this.status === 429;
   }
 }
 
@@ -118,33 +197,35 @@ export class PmcApi {
     return `${this.base}/${path}${qs ? `?${qs}` : ''}`;
   }
 
-  private async request(url: string, signal?: AbortSignal): Promise<Response> {
+  private async request(url: string, signal?: AbortSignal, init: RequestInit = {}): Promise<Response> {
     let res: Response;
     try {
-      res = await this.fetchFn(url, signal ? { signal } : {});
+      res = await this.fetchFn(url, signal ? { ...init, signal } : init);
     } catch (e) {
       if (isAbort(e)) throw e;
       throw new ApiError(`cannot reach the PMC server (${String(e)})`, 0, url);
     }
     if (!res.ok) {
       let message = `${res.status} ${res.statusText}`.trim();
+      let serverMessage: string | null = null;
       try {
         const body: unknown = await res.json();
         if (body && typeof body === 'object' && 'error' in body) {
-          message = `${message}: ${String((body as { error: unknown }).error)}`;
+          serverMessage = String((body as { error: unknown }).error);
+          message = `${message}: ${serverMessage}`;
         }
       } catch {
         // not JSON: keep the status line
       }
       const ra = res.headers.get('Retry-After');
-      const retryAfter = ra !== null && Number.isFinite(Number(ra)) ? Number(ra) : null;
-      throw new ApiError(message, res.status, url, retryAfter);
+      const retryAfter = ra !== null && ra.trim() !== '' && Number.isFinite(Number(ra)) ? Number(ra) : null;
+      throw new ApiError(message, res.status, url, retryAfter, serverMessage);
     }
     return res;
   }
 
-  private async json<T>(url: string, signal?: AbortSignal): Promise<T> {
-    const res = await this.request(url, signal);
+  private async json<T>(url: string, signal?: AbortSignal, init?: RequestInit): Promise<T> {
+    const res = await this.request(url, signal, init);
     try {
       return (await res.json()) as T;
     } catch (e) {
@@ -200,4 +281,71 @@ export class PmcApi {
   stats(signal?: AbortSignal): Promise<Record<string, number>> {
     return this.json(this.url('stats'), signal);
   }
+
+  // ---- editing (a server started with `--world`) ---------------------------------------------
+
+  /**
+   * Applies a brush (`POST /edits`). `planet` names the planet the viewer shows: the server
+   * refuses (409) an edit of any planet but the world's.
+   */
+  async postEdit(edit: EditRequest, planet: PlanetChoice = {}, signal?: AbortSignal): Promise<EditAnswer> {
+    const url = this.url('edits', planet);
+    return checkEditAnswer(
+      await this.json<unknown>(url, signal, {
+        method: 'POST',
+        headers: { 'Content-Type': 'application/json' },
+        body: JSON.stringify(edit),
+      }),
+      url,
+    );
+  }
+
+  /** Takes back the last active edit (`POST /edits/undo`); `id` null when there was none. */
+  async undo(planet: PlanetChoice = {}, signal?: AbortSignal): Promise<EditAnswer> {
+    const url = this.url('edits/undo', planet);
+    return checkEditAnswer(await this.json<unknown>(url, signal, { method: 'POST' }), url);
+  }
+
+  /** Re-applies the most recently undone edit (`POST /edits/redo`); `id` null when there was none. */
+  async redo(planet: PlanetChoice = {}, signal?: AbortSignal): Promise<EditAnswer> {
+    const url = this.url('edits/redo', planet);
+    return checkEditAnswer(await this.json<unknown>(url, signal, { method: 'POST' }), url);
+  }
+
+  /** The edit list (`GET /edits`), oldest first, active ones before undone ones. */
+  async listEdits(planet: PlanetChoice = {}, signal?: AbortSignal): Promise<EditList> {
+    const url = this.url('edits', planet);
+    const list = await this.json<EditList>(url, signal);
+    if (!list || typeof list.revision !== 'number' || !Array.isArray(list.edits)) {
+      throw new ApiError(`unexpected answer from ${url}: no revision or edits`, 200, url);
+    }
+    return list;
+  }
+
+  /** The URL of the server push (`GET /events`, Server-Sent Events). */
+  eventsUrl(): string {
+    return this.url('events');
+  }
+}
+
+/** Checks the shape of an edit, undo or redo answer. */
+function checkEditAnswer(body: unknown, url: string): EditAnswer {
+  const a = body as Partial<EditAnswer> | null;
+  if (
+    !a ||
+    typeof a !== 'object' ||
+    typeof a.revision !== 'number' ||
+    !(a.id === null || typeof a.id === 'number') ||
+    !Array.isArray(a.chunks) ||
+    !a.chunks.every((k) => typeof k === 'string')
+  ) {
+    throw new ApiError(`unexpected answer from ${url}: ${JSON.stringify(body)?.slice(0, 200)}`, 200, url);
+  }
+  return {
+    id: a.id,
+    revision: a.revision,
+    active: typeof a.active === 'number' ? a.active : 0,
+    redo: typeof a.redo === 'number' ? a.redo : 0,
+    chunks: a.chunks,
+  };
 }

@@ -19,10 +19,13 @@ import {
 } from './cameraModel';
 import { ChunkStreamer } from './chunkStreamer';
 import { loadRange } from './chunkSelection';
+import { EditSession, type EditStatus } from './editSession';
+import { toolByName, toolForKey } from './editTools';
 import { addScaled, cameraBasis, enuAt, length, normalize, wrapLon, type V3 } from './frames';
 import { Input } from './input';
 import { planetParams, type PlanetParams } from './planetParams';
 import { PlanetScene, type DebugFlags } from './planetScene';
+import { ToolsUi } from './toolsUi';
 import { Ui } from './ui';
 import { formatHash, parseHash, type UrlState } from './urlState';
 
@@ -53,6 +56,23 @@ export interface PmcStats {
   ready: boolean;
   error: string | null;
   loadedKeys: string[];
+  /** Loaded chunks waiting for a refetch after an edit, refetches under way, refetches made. */
+  stale: number;
+  reloading: number;
+  reloads: number;
+  /** Whether the brush cursor is drawn. */
+  cursor: boolean;
+  edit: EditStatus;
+}
+
+/** A point of the loaded terrain under a pixel. */
+export interface PickResult {
+  /** Metres from the camera along the ray. */
+  distance: number;
+  /** The point, planet frame, metres. */
+  point: V3;
+  /** The chunk hit. */
+  key: string;
 }
 
 export interface PmcTestHook {
@@ -64,6 +84,8 @@ export interface PmcTestHook {
   /** Switches to `name` ('orbit', 'fly' or 'walk') when given; returns the current mode. */
   mode(name?: ModeName): ModeName;
   debug(flags: Partial<DebugFlags>): DebugFlags;
+  /** The loaded terrain under canvas pixel (x, y) (CSS pixels from the top left), or null. */
+  pick(x: number, y: number): PickResult | null;
 }
 
 declare global {
@@ -83,6 +105,9 @@ export class App {
   private readonly scene = new PlanetScene();
   private readonly streamer: ChunkStreamer;
   private readonly ui: Ui;
+  private readonly toolsUi: ToolsUi;
+  private readonly editor: EditSession;
+  private editChanged = true;
   private readonly input: Input;
   private readonly raycaster = new THREE.Raycaster();
   private readonly frustum = new THREE.Frustum();
@@ -112,6 +137,8 @@ export class App {
   private settledFrames = 0;
   private readyWaiters: { resolve: () => void; reject: (e: Error) => void; timer: number }[] = [];
   private error: string | null = null;
+  /** The camera of the last frame, planet frame (the floating origin). */
+  private cameraPos: V3 = [0, 0, 0];
 
   constructor(private readonly canvas: HTMLCanvasElement) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, powerPreference: 'high-performance' });
@@ -135,14 +162,32 @@ export class App {
         this.ui.setDebug(this.scene.debug());
       },
     });
+    this.editor = new EditSession({
+      api: this.api,
+      chunks: this.streamer,
+      eventSource: typeof EventSource === 'function' ? (url) => new EventSource(url) : null,
+      onChange: () => {
+        this.editChanged = true;
+      },
+    });
+    this.toolsUi = new ToolsUi({
+      onTool: (tool) => this.editor.setTool(tool),
+      onRadius: (r) => this.editor.setRadius(r),
+      onStrength: (st) => this.editor.setStrength(st),
+      onMaterial: (m) => this.editor.setMaterial(m),
+      onUndo: () => void this.editor.undo(),
+      onRedo: () => void this.editor.redo(),
+    });
     this.input = new Input(canvas, {
       onToggleMode: () => this.setMode(this.mode === 'orbit' ? 'fly' : 'orbit'),
       onToggleWalk: () => {
         if (this.mode === 'fly') this.setWalk(!this.walk);
       },
+      brushActive: () => this.editor.brushActive,
+      onShortcut: (e) => this.shortcut(e),
     });
     canvas.addEventListener('dblclick', () => {
-      if (this.mode === 'fly') this.input.requestPointerLock();
+      if (this.mode === 'fly' && !this.editor.brushActive) this.input.requestPointerLock();
     });
     window.addEventListener('resize', () => this.resize());
     window.addEventListener('hashchange', () => this.onHashChange());
@@ -191,6 +236,7 @@ export class App {
     this.params = planetParams(info);
     this.choice = { preset: info.preset, seed: info.seed };
     this.streamer.setPlanet(this.choice);
+    this.editor.setPlanet(info);
     this.scene.clearChunks();
     this.scene.setPlanet(this.params);
     const shape = this.params.shape;
@@ -311,6 +357,90 @@ export class App {
     }
   }
 
+  // ---- editing ------------------------------------------------------------------------------
+
+  /** Editing shortcuts (outside text fields); true when `e` was one. */
+  private shortcut(e: KeyboardEvent): boolean {
+    const mod = e.ctrlKey || e.metaKey;
+    if (mod) {
+      if (e.altKey || !this.editor.enabled) return false;
+      if (e.code === 'KeyZ') {
+        if (!e.repeat) void (e.shiftKey ? this.editor.redo() : this.editor.undo());
+        return true;
+      }
+      if (e.code === 'KeyY' && !e.shiftKey) {
+        if (!e.repeat) void this.editor.redo();
+        return true;
+      }
+      return false;
+    }
+    if (e.altKey) return false;
+    const tool = toolForKey(e.code);
+    if (tool) {
+      if (tool === 'look' && this.editor.currentTool === 'look') return false;
+      this.editor.setTool(tool);
+      return true;
+    }
+    if ((e.code === 'BracketLeft' || e.code === 'BracketRight') && this.editor.enabled) {
+      this.editor.stepRadius(e.code === 'BracketRight' ? 1 : -1);
+      return true;
+    }
+    return false;
+  }
+
+  private readonly ndc = new THREE.Vector2();
+
+  /** The loaded terrain under canvas pixel (x, y), with the camera of the last frame. */
+  private pick(x: number, y: number): (PickResult & { render: V3 }) | null {
+    const w = this.canvas.clientWidth || window.innerWidth;
+    const h = this.canvas.clientHeight || window.innerHeight;
+    if (!(w > 0 && h > 0) || !this.params) return null;
+    this.ndc.set((2 * x) / w - 1, 1 - (2 * y) / h);
+    this.raycaster.setFromCamera(this.ndc, this.camera);
+    this.raycaster.near = this.camera.near;
+    this.raycaster.far = this.camera.far;
+    const hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
+    const hit = hits[0];
+    if (!hit) return null;
+    const cam = this.cameraPos;
+    // render space is relative to the camera (floating origin): add it back in f64
+    const render: V3 = [hit.point.x, hit.point.y, hit.point.z];
+    return {
+      distance: hit.distance,
+      point: [render[0] + cam[0], render[1] + cam[1], render[2] + cam[2]],
+      key: hit.object.name,
+      render,
+    };
+  }
+
+  /** The brush under the mouse: cursor, press, drag and release. */
+  private brushFrame(input: ReturnType<Input['take']>): void {
+    if (!this.editor.brushActive) {
+      this.scene.setBrushCursor(null);
+      if (input.brushRelease) this.editor.release();
+      this.canvas.classList.remove('brush');
+      return;
+    }
+    this.canvas.classList.add('brush');
+    if (input.brushPress) this.editor.press(this.pick(input.brushPress.x, input.brushPress.y)?.point ?? null);
+    const ptr = this.input.pointer();
+    const hit = ptr ? this.pick(ptr.x, ptr.y) : null;
+    this.editor.frame(hit ? hit.point : null);
+    if (input.brushRelease) this.editor.release();
+    if (hit) {
+      this.scene.setBrushCursor(hit.render, this.editor.radius, normalize(hit.point), toolByName(this.editor.currentTool).colour);
+    } else {
+      this.scene.setBrushCursor(null);
+    }
+  }
+
+  private editStatsText(s: EditStatus): { text: string; push: string } {
+    if (!s.enabled) return { text: 'off', push: '–' };
+    const push = s.push === 'open' ? 'live' : s.push === 'off' ? 'off' : s.push;
+    const counts = s.active !== null ? ` · ${s.active} active${s.redo ? ` · ${s.redo} undone` : ''}` : '';
+    return { text: `rev ${s.revision ?? '?'}${counts}`, push };
+  }
+
   // ---- frame loop ---------------------------------------------------------------------------
 
   private resize(): void {
@@ -346,6 +476,10 @@ export class App {
     if (!params) {
       this.renderer.render(this.scene.scene, this.camera);
       this.ui.setLoading(0, 0, this.planetBusy ?? 'waiting for the server');
+      if (this.editChanged) {
+        this.editChanged = false;
+        this.toolsUi.update(this.editor.status());
+      }
       return;
     }
     const shape = params.shape;
@@ -422,6 +556,8 @@ export class App {
     this.range = loadRange(r, params.extent, Math.max(4 * params.chunkWidth, 100));
     this.camera.far = Math.max(this.camera.near * 10, this.range * 1.05 + params.chunkWidth);
     this.camera.updateProjectionMatrix();
+    this.cameraPos = pos;
+    this.brushFrame(input);
 
     // sky: blue near the ground, black from orbit
     const aboveSea = r - (params.seaRadius ?? shape.datum);
@@ -469,6 +605,13 @@ export class App {
         heading: this.state.heading,
       });
       this.ui.setLoading(st.pending, st.missing, this.planetBusy);
+      const es = this.editor.status();
+      const et = this.editStatsText(es);
+      this.ui.setEditStats(et.text, et.push, es.error);
+    }
+    if (this.editChanged) {
+      this.editChanged = false;
+      this.toolsUi.update(this.editor.status());
     }
     if (moved) this.writeHash(false);
   }
@@ -512,6 +655,11 @@ export class App {
       ready: this.settledFrames >= 2,
       error: this.error,
       loadedKeys: this.streamer.loadedKeys(),
+      stale: st.stale,
+      reloading: st.reloading,
+      reloads: st.reloads,
+      cursor: this.scene.brushCursorVisible(),
+      edit: this.editor.status(),
     };
   }
 
@@ -547,6 +695,10 @@ export class App {
         this.scene.setDebug(flags);
         this.ui.setDebug(this.scene.debug());
         return this.scene.debug();
+      },
+      pick: (x, y) => {
+        const p = this.pick(x, y);
+        return p ? { distance: p.distance, point: p.point, key: p.key } : null;
       },
     };
   }

@@ -35,6 +35,8 @@ export interface StreamerOptions {
 interface Pending {
   bounds: ChunkBounds;
   abort: AbortController;
+  /** A refetch of a chunk that stays on screen until the new data arrives. */
+  reload: boolean;
 }
 
 interface Loaded {
@@ -56,6 +58,11 @@ export interface StreamerStats {
   requested: number;
   failed: number;
   listInFlight: boolean;
+  /** Loaded chunks waiting to be fetched again (edited), and refetches under way. */
+  stale: number;
+  reloading: number;
+  /** Chunk refetches made since the planet was chosen. */
+  reloads: number;
 }
 
 export class ChunkStreamer {
@@ -68,6 +75,11 @@ export class ChunkStreamer {
   private readonly loaded = new Map<string, Loaded>();
   private readonly pending = new Map<string, Pending>();
   private readonly failures = new Map<string, { count: number; retryAt: number }>();
+  /** Loaded chunks whose data is out of date (an edit named them): fetch again, keep showing. */
+  private readonly stale = new Set<string>();
+  /** Pending chunks an edit named while their fetch was in flight: fetch again after it answers. */
+  private readonly refetch = new Set<string>();
+  private reloads = 0;
   private missing = 0;
   private requested = 0;
   private failed = 0;
@@ -98,6 +110,9 @@ export class ChunkStreamer {
     for (const key of [...this.loaded.keys()]) this.callbacks.onUnload(key);
     this.loaded.clear();
     this.failures.clear();
+    this.stale.clear();
+    this.refetch.clear();
+    this.reloads = 0;
     this.candidates = [];
     this.lastQuery = null;
     this.listRetryAt = 0;
@@ -110,6 +125,36 @@ export class ChunkStreamer {
   /** Stops everything (the planet is being replaced or the page closed). */
   clear(): void {
     this.setPlanet(this.planet);
+  }
+
+  /**
+   * The data of `keys` changed on the server (an edit): every one that is loaded is fetched again
+   * and its mesh replaced only when the new data arrives (no hole meanwhile); every one whose
+   * fetch is in flight is fetched once more after that answer (which may predate the change).
+   * Keys neither loaded nor pending are ignored: they will be fetched fresh when wanted. The chunk
+   * list is queried again too (an edit can make chunks hold surface that did not).
+   * Returns how many chunks were marked.
+   */
+  reload(keys: Iterable<string>): number {
+    let n = 0;
+    for (const key of keys) {
+      if (this.pending.has(key)) {
+        this.refetch.add(key);
+        n++;
+      } else if (this.loaded.has(key)) {
+        this.stale.add(key);
+        // an edit is a new reason to try: forget the back-off of an earlier failure
+        this.failures.delete(key);
+        n++;
+      }
+    }
+    if (n > 0) this.lastQuery = null;
+    return n;
+  }
+
+  /** Every chunk's data changed (a `resync`): fetch all the loaded and pending ones again. */
+  reloadAll(): number {
+    return this.reload([...this.loaded.keys(), ...this.pending.keys()]);
   }
 
   /**
@@ -127,6 +172,20 @@ export class ChunkStreamer {
     }
     const blocked = new Set<string>();
     for (const [key, f] of this.failures) if (now < f.retryAt) blocked.add(key);
+    // refetches of edited chunks come first: the user is looking at them
+    if (this.stale.size > 0) {
+      for (const key of this.stale) {
+        if (this.pending.size >= this.maxConcurrent) break;
+        if (blocked.has(key) || this.pending.has(key)) continue;
+        const l = this.loaded.get(key);
+        if (!l) {
+          this.stale.delete(key);
+          continue;
+        }
+        this.stale.delete(key);
+        this.request(key, l.bounds, true);
+      }
+    }
     const sel = selectChunks({
       camera,
       range,
@@ -141,9 +200,13 @@ export class ChunkStreamer {
     for (const key of sel.cancel) {
       this.pending.get(key)?.abort.abort();
       this.pending.delete(key);
+      this.refetch.delete(key);
+      // a cancelled refetch of a chunk still shown must be tried again
+      if (this.loaded.has(key)) this.stale.add(key);
     }
     for (const key of sel.unload) {
       this.loaded.delete(key);
+      this.stale.delete(key);
       this.callbacks.onUnload(key);
     }
     const byKey = new Map(this.candidates.map((c) => [c.key, c]));
@@ -179,11 +242,12 @@ export class ChunkStreamer {
       });
   }
 
-  private request(key: string, bounds: ChunkBounds): void {
+  private request(key: string, bounds: ChunkBounds, reload = false): void {
     const generation = this.generation;
     const abort = new AbortController();
-    this.pending.set(key, { bounds, abort });
+    this.pending.set(key, { bounds, abort, reload });
     this.requested++;
+    if (reload) this.reloads++;
     this.api
       .chunk(this.planet, key, abort.signal)
       .then((chunk) => {
@@ -196,12 +260,18 @@ export class ChunkStreamer {
           vertices: chunk.vertexCount,
           bytes: chunk.byteLength,
         });
+        // named by an edit while in flight: this answer may predate it, so fetch once more
+        if (this.refetch.delete(key)) this.stale.add(key);
         this.callbacks.onLoad(key, chunk, bounds);
         this.recovered();
       })
       .catch((e: unknown) => {
         if (generation !== this.generation || this.pending.get(key)?.abort !== abort) return;
         this.pending.delete(key);
+        // a chunk still shown keeps its old mesh and is tried again (after the back-off)
+        if (this.refetch.delete(key) || reload) {
+          if (this.loaded.has(key)) this.stale.add(key);
+        }
         if (isAbort(e)) return;
         this.failed++;
         const prev = this.failures.get(key)?.count ?? 0;
@@ -226,11 +296,15 @@ export class ChunkStreamer {
     }
   }
 
-  /** True when nothing is pending or missing, the chunk list is current and a chunk is loaded. */
+  /**
+   * True when nothing is pending, missing or stale, the chunk list is current and a chunk is
+   * loaded.
+   */
   settled(camera: V3, range: number): boolean {
     return (
       this.loaded.size > 0 &&
       this.pending.size === 0 &&
+      this.stale.size === 0 &&
       this.missing === 0 &&
       this.listAbort === null &&
       !needsRequery(this.lastQuery, camera, range, this.requeryFraction)
@@ -246,6 +320,8 @@ export class ChunkStreamer {
       vertices += l.vertices;
       bytes += l.bytes;
     }
+    let reloading = 0;
+    for (const p of this.pending.values()) if (p.reload) reloading++;
     return {
       loaded: this.loaded.size,
       pending: this.pending.size,
@@ -256,6 +332,9 @@ export class ChunkStreamer {
       requested: this.requested,
       failed: this.failed,
       listInFlight: this.listAbort !== null,
+      stale: this.stale.size,
+      reloading,
+      reloads: this.reloads,
     };
   }
 

@@ -11,6 +11,10 @@ export interface InputFrame {
   up: number;
   /** Held "fast" modifier (Ctrl / Alt) */
   fast: boolean;
+  /** With a brush tool: where the left button went down (canvas pixels) since the last frame. */
+  brushPress: { x: number; y: number } | null;
+  /** With a brush tool: the left button went up since the last frame (after `brushPress`). */
+  brushRelease: boolean;
 }
 
 const FORWARD = new Set(['KeyW', 'ArrowUp']);
@@ -19,12 +23,24 @@ const LEFT = new Set(['KeyA', 'ArrowLeft']);
 const RIGHT = new Set(['KeyD', 'ArrowRight']);
 const UP = new Set(['KeyE', 'Space', 'PageUp']);
 const DOWN = new Set(['KeyQ', 'ShiftLeft', 'ShiftRight', 'PageDown']);
+/** Every key this module gives a meaning to (other shortcuts must not use them). */
+export const BOUND_KEYS: ReadonlySet<string> = new Set([
+  ...FORWARD, ...BACK, ...LEFT, ...RIGHT, ...UP, ...DOWN,
+  'Tab', 'KeyG', 'ControlLeft', 'AltLeft',
+]);
 
 export interface InputCallbacks {
   /** Tab: switch between orbit and fly. */
   onToggleMode(): void;
   /** G: walk on / off. */
   onToggleWalk(): void;
+  /**
+   * Whether a brush tool is chosen: then the left button edits (see `brushPress`) and only the
+   * right button moves the camera.
+   */
+  brushActive?(): boolean;
+  /** A key went down outside text fields; return true when it was a shortcut (consumed). */
+  onShortcut?(e: KeyboardEvent): boolean;
 }
 
 export class Input {
@@ -35,6 +51,11 @@ export class Input {
   private dragging = false;
   private lastX = 0;
   private lastY = 0;
+  private brushing = false;
+  private brushPress: { x: number; y: number } | null = null;
+  private brushRelease = false;
+  /** The mouse over the canvas (canvas pixels), or null when it is elsewhere. */
+  private hover: { x: number; y: number } | null = null;
   private readonly disposers: (() => void)[] = [];
 
   constructor(
@@ -52,9 +73,16 @@ export class Input {
     };
     on(element, 'pointerdown', (e) => {
       if (e.button !== 0 && e.button !== 2) return;
-      this.dragging = true;
-      this.lastX = e.clientX;
-      this.lastY = e.clientY;
+      this.hover = this.local(e);
+      if (e.button === 0 && this.callbacks.brushActive?.()) {
+        this.brushing = true;
+        this.brushPress = this.local(e);
+        this.brushRelease = false;
+      } else {
+        this.dragging = true;
+        this.lastX = e.clientX;
+        this.lastY = e.clientY;
+      }
       element.setPointerCapture?.(e.pointerId);
       element.focus();
     });
@@ -64,6 +92,7 @@ export class Input {
         this.dragY += e.movementY;
         return;
       }
+      this.hover = this.local(e);
       if (!this.dragging) return;
       this.dragX += e.clientX - this.lastX;
       this.dragY += e.clientY - this.lastY;
@@ -71,11 +100,20 @@ export class Input {
       this.lastY = e.clientY;
     });
     const stop = (e: PointerEvent): void => {
-      this.dragging = false;
-      if (element.hasPointerCapture?.(e.pointerId)) element.releasePointerCapture(e.pointerId);
+      if (this.brushing && (e.button === 0 || e.type === 'pointercancel')) {
+        this.brushing = false;
+        this.brushRelease = true;
+      }
+      if (e.button === 0 || e.button === 2 || e.type === 'pointercancel') this.dragging = false;
+      if (!this.brushing && !this.dragging && element.hasPointerCapture?.(e.pointerId)) {
+        element.releasePointerCapture(e.pointerId);
+      }
     };
     on(element, 'pointerup', stop);
     on(element, 'pointercancel', stop);
+    on(element, 'pointerleave', () => {
+      if (!this.brushing && !this.dragging) this.hover = null;
+    });
     on(
       element,
       'wheel',
@@ -89,6 +127,10 @@ export class Input {
     on(element, 'contextmenu', (e) => e.preventDefault());
     on(window, 'keydown', (e) => {
       if (isTyping(e.target)) return;
+      if (this.callbacks.onShortcut?.(e)) {
+        e.preventDefault();
+        return;
+      }
       if (e.code === 'Tab') {
         e.preventDefault();
         this.callbacks.onToggleMode();
@@ -109,7 +151,35 @@ export class Input {
     on(window, 'blur', () => {
       this.held.clear();
       this.dragging = false;
+      if (this.brushing) {
+        this.brushing = false;
+        this.brushRelease = true;
+      }
     });
+  }
+
+  private local(e: PointerEvent): { x: number; y: number } {
+    if (document.pointerLockElement === this.element) {
+      return { x: this.element.clientWidth / 2, y: this.element.clientHeight / 2 };
+    }
+    const r = this.element.getBoundingClientRect();
+    return { x: e.clientX - r.left, y: e.clientY - r.top };
+  }
+
+  /**
+   * The point the mouse is over, canvas pixels (the centre under pointer lock), or null when it
+   * is not over the canvas.
+   */
+  pointer(): { x: number; y: number } | null {
+    if (document.pointerLockElement === this.element) {
+      return { x: this.element.clientWidth / 2, y: this.element.clientHeight / 2 };
+    }
+    return this.hover;
+  }
+
+  /** Whether the left button is held for a brush. */
+  get brushHeld(): boolean {
+    return this.brushing;
   }
 
   /** Asks for pointer lock (fly mode mouse look without dragging). */
@@ -126,9 +196,12 @@ export class Input {
 
   /** The input since the last call. */
   take(): InputFrame {
+    // with Ctrl (or Cmd) held, Shift is part of a shortcut (Ctrl+Shift+Z: redo), not "down"
+    const chord = ['ControlLeft', 'ControlRight', 'MetaLeft', 'MetaRight'].some((k) => this.held.has(k));
     const axis = (pos: Set<string>, neg: Set<string>): number => {
       let v = 0;
       for (const k of this.held) {
+        if (chord && (k === 'ShiftLeft' || k === 'ShiftRight')) continue;
         if (pos.has(k)) v = Math.min(1, v + 1);
         if (neg.has(k)) v = Math.max(-1, v - 1);
       }
@@ -142,7 +215,11 @@ export class Input {
       right: axis(RIGHT, LEFT),
       up: axis(UP, DOWN),
       fast: this.held.has('ControlLeft') || this.held.has('AltLeft'),
+      brushPress: this.brushPress,
+      brushRelease: this.brushRelease,
     };
+    this.brushPress = null;
+    this.brushRelease = false;
     this.dragX = 0;
     this.dragY = 0;
     this.wheel = 0;

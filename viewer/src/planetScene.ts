@@ -89,9 +89,59 @@ export class PlanetScene {
 
   private readonly background = SPACE_BACKGROUND.clone();
 
+  /** The brush cursor: a translucent ball of the brush radius and a ring across it. */
+  private readonly cursor = new THREE.Group();
+  private readonly cursorBallMaterial = new THREE.MeshBasicMaterial({
+    color: 0xffffff,
+    transparent: true,
+    opacity: 0.22,
+    depthWrite: false,
+  });
+  private readonly cursorRingMaterial = new THREE.LineBasicMaterial({
+    color: 0xffffff,
+    transparent: true,
+    opacity: 0.9,
+    depthTest: false,
+    depthWrite: false,
+  });
+
   constructor() {
     this.scene.background = this.background;
     this.scene.add(this.terrainGroup);
+    const ball = new THREE.Mesh(new THREE.SphereGeometry(1, 32, 16), this.cursorBallMaterial);
+    ball.renderOrder = 20; // after the sea
+    const ringPoints: THREE.Vector3[] = [];
+    for (let i = 0; i < 64; i++) {
+      const a = (i / 64) * Math.PI * 2;
+      ringPoints.push(new THREE.Vector3(Math.cos(a), 0, Math.sin(a)));
+    }
+    const ring = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(ringPoints), this.cursorRingMaterial);
+    ring.renderOrder = 21;
+    this.cursor.add(ball, ring);
+    this.cursor.name = 'brush-cursor';
+    this.cursor.visible = false;
+    this.scene.add(this.cursor);
+  }
+
+  /**
+   * Shows the brush cursor at `at` (render space: relative to the camera) with `radius` metres,
+   * its ring across the local vertical `up`, in `colour` (linear RGB); null hides it.
+   */
+  setBrushCursor(at: V3 | null, radius = 1, up: V3 = [0, 1, 0], colour: [number, number, number] = [1, 1, 1]): void {
+    if (!at) {
+      this.cursor.visible = false;
+      return;
+    }
+    this.cursor.visible = true;
+    this.cursor.position.set(at[0], at[1], at[2]);
+    this.cursor.scale.setScalar(Math.max(1e-3, radius));
+    this.cursor.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), new THREE.Vector3(up[0], up[1], up[2]).normalize());
+    this.cursorBallMaterial.color.setRGB(colour[0], colour[1], colour[2]);
+    this.cursorRingMaterial.color.setRGB(colour[0], colour[1], colour[2]);
+  }
+
+  brushCursorVisible(): boolean {
+    return this.cursor.visible;
   }
 
   /** Background between space (0) and a clear sky seen from the ground (1). */
@@ -313,5 +363,7 @@ export class PlanetScene {
     this.removeSea();
     this.seaMaterial.dispose();
     this.borderMaterial.dispose();
+    this.cursorBallMaterial.dispose();
+    this.cursorRingMaterial.dispose();
   }
 }

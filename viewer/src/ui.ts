@@ -64,6 +64,9 @@ export class Ui {
     alt: byId('s-alt'),
     ground: byId('s-ground'),
     heading: byId('s-heading'),
+    edits: byId('s-edits'),
+    push: byId('s-push'),
+    editError: byId('s-edit-error'),
   };
   private mode: CameraMode = 'orbit';
 
@@ -155,6 +158,17 @@ export class Ui {
 
   errorMessage(): string | null {
     return this.error.hidden ? null : this.errorText.textContent;
+  }
+
+  /**
+   * The edit lines of the stats panel (the revision and counts, the push state) and the last edit
+   * error (null: none; its row hides).
+   */
+  setEditStats(text: string, push: string, error: string | null): void {
+    this.fields.edits.textContent = text;
+    this.fields.push.textContent = push;
+    this.fields.editError.textContent = error ?? '';
+    for (const el of document.querySelectorAll<HTMLElement>('#stats .edit-error')) el.hidden = error === null;
   }
 
   setStats(s: StatsView): void {

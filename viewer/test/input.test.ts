@@ -1,0 +1,124 @@
+// Input with the DOM stubbed by EventTargets (vitest runs in node): the mouse buttons with and
+// without a brush tool, the editing shortcuts, and Shift inside a Ctrl chord.
+
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { Input } from '../src/input';
+
+const g = globalThis as Record<string, unknown>;
+const saved: Record<string, unknown> = {};
+
+beforeAll(() => {
+  for (const k of ['window', 'document', 'HTMLInputElement', 'HTMLSelectElement', 'HTMLTextAreaElement']) saved[k] = g[k];
+  g['window'] = new EventTarget();
+  g['document'] = { pointerLockElement: null };
+  g['HTMLInputElement'] = class {};
+  g['HTMLSelectElement'] = class {};
+  g['HTMLTextAreaElement'] = class {};
+});
+
+afterAll(() => {
+  for (const [k, v] of Object.entries(saved)) g[k] = v;
+});
+
+class FakeCanvas extends EventTarget {
+  clientWidth = 800;
+  clientHeight = 600;
+  captured = new Set<number>();
+  focus(): void {}
+  getBoundingClientRect() {
+    return { left: 10, top: 20, width: 800, height: 600 };
+  }
+  setPointerCapture(id: number): void {
+    this.captured.add(id);
+  }
+  hasPointerCapture(id: number): boolean {
+    return this.captured.has(id);
+  }
+  releasePointerCapture(id: number): void {
+    this.captured.delete(id);
+  }
+}
+
+const pointer = (type: string, button: number, x: number, y: number): Event =>
+  Object.assign(new Event(type), { button, clientX: x, clientY: y, pointerId: 1, movementX: 0, movementY: 0 });
+const key = (type: string, code: string, mods: Partial<KeyboardEvent> = {}): Event =>
+  Object.assign(new Event(type, { cancelable: true }), { code, repeat: false, ctrlKey: false, shiftKey: false, metaKey: false, altKey: false, ...mods });
+
+function setup(brush: { active: boolean }) {
+  const canvas = new FakeCanvas();
+  const shortcuts: string[] = [];
+  const input = new Input(canvas as unknown as HTMLElement, {
+    onToggleMode: () => shortcuts.push('mode'),
+    onToggleWalk: () => shortcuts.push('walk'),
+    brushActive: () => brush.active,
+    onShortcut: (e) => {
+      if (e.code === 'KeyZ' && e.ctrlKey) {
+        shortcuts.push(e.shiftKey ? 'redo' : 'undo');
+        return true;
+      }
+      return false;
+    },
+  });
+  const win = g['window'] as EventTarget;
+  return { canvas, input, shortcuts, win };
+}
+
+describe('Input', () => {
+  it('drags the camera with either button when no brush tool is chosen', () => {
+    const { canvas, input } = setup({ active: false });
+    canvas.dispatchEvent(pointer('pointerdown', 0, 100, 100));
+    canvas.dispatchEvent(pointer('pointermove', 0, 130, 90));
+    canvas.dispatchEvent(pointer('pointerup', 0, 130, 90));
+    const f = input.take();
+    expect([f.dragX, f.dragY, f.brushPress, f.brushRelease]).toEqual([30, -10, null, false]);
+    input.dispose();
+  });
+
+  it('with a brush: the left button presses the brush, the right one still drags the camera', () => {
+    const brush = { active: true };
+    const { canvas, input } = setup(brush);
+    canvas.dispatchEvent(pointer('pointermove', -1, 60, 70));
+    expect(input.pointer()).toEqual({ x: 50, y: 50 });
+    canvas.dispatchEvent(pointer('pointerdown', 0, 110, 120));
+    canvas.dispatchEvent(pointer('pointermove', 0, 150, 120));
+    let f = input.take();
+    expect(f.brushPress).toEqual({ x: 100, y: 100 });
+    expect([f.dragX, f.dragY]).toEqual([0, 0]); // the left button does not move the camera
+    expect(input.brushHeld).toBe(true);
+    expect(input.pointer()).toEqual({ x: 140, y: 100 });
+    canvas.dispatchEvent(pointer('pointerup', 0, 150, 120));
+    f = input.take();
+    expect([f.brushPress, f.brushRelease, input.brushHeld]).toEqual([null, true, false]);
+    // right drag
+    canvas.dispatchEvent(pointer('pointerdown', 2, 200, 200));
+    canvas.dispatchEvent(pointer('pointermove', 2, 190, 230));
+    canvas.dispatchEvent(pointer('pointerup', 2, 190, 230));
+    f = input.take();
+    expect([f.dragX, f.dragY, f.brushPress]).toEqual([-10, 30, null]);
+    canvas.dispatchEvent(new Event('pointerleave'));
+    expect(input.pointer()).toBeNull();
+    input.dispose();
+  });
+
+  it('gives shortcuts first say, and Shift inside a Ctrl chord does not fly down', () => {
+    const { input, shortcuts, win } = setup({ active: false });
+    win.dispatchEvent(key('keydown', 'ControlLeft', { ctrlKey: true }));
+    win.dispatchEvent(key('keydown', 'ShiftLeft', { ctrlKey: true, shiftKey: true }));
+    let f = input.take();
+    expect([f.up, f.fast]).toEqual([0, true]);
+    const z = key('keydown', 'KeyZ', { ctrlKey: true, shiftKey: true });
+    win.dispatchEvent(z);
+    expect(z.defaultPrevented).toBe(true);
+    expect(shortcuts).toEqual(['redo']);
+    win.dispatchEvent(key('keyup', 'ControlLeft'));
+    f = input.take();
+    expect(f.up).toBe(-1); // Shift alone is "down" again
+    win.dispatchEvent(key('keyup', 'ShiftLeft'));
+    win.dispatchEvent(key('keydown', 'KeyG'));
+    win.dispatchEvent(key('keydown', 'KeyW'));
+    f = input.take();
+    expect(shortcuts).toEqual(['redo', 'walk']);
+    expect(f.forward).toBe(1);
+    input.dispose();
+  });
+});
