@@ -321,28 +321,36 @@ pub async fn events(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
     // Subscribe before reading the revision, so no change falls between the two.
     let rx = editing.subscribe();
     let hello = sse_event("hello", &json!({ "revision": editing.current().revision }));
-    let state = (Some(hello), rx, editing);
-    let stream = futures_util::stream::unfold(state, |(first, mut rx, editing)| async move {
-        if let Some(hello) = first {
-            return Some((Ok::<Event, Infallible>(hello), (None, rx, editing)));
-        }
-        let event = match rx.recv().await {
-            Ok(e) => sse_event(e.event, &e),
-            Err(broadcast::error::RecvError::Lagged(_)) => {
-                // Too far behind to replay: reload everything at the current revision.
-                let e = EditEvent {
-                    event: "resync",
-                    revision: editing.current().revision,
-                    action: None,
-                    id: None,
-                    chunks: Vec::new(),
-                };
-                sse_event(e.event, &e)
+    let stop = state.stopping();
+    let stream = futures_util::stream::unfold(
+        (Some(hello), rx, editing, stop),
+        |(first, mut rx, editing, mut stop)| async move {
+            if let Some(hello) = first {
+                return Some((Ok::<Event, Infallible>(hello), (None, rx, editing, stop)));
             }
-            Err(broadcast::error::RecvError::Closed) => return None,
-        };
-        Some((Ok(event), (None, rx, editing)))
-    });
+            let received = tokio::select! {
+                r = rx.recv() => r,
+                // The server is stopping (or gone): end the stream.
+                _ = stop.wait_for(|s| *s) => return None,
+            };
+            let event = match received {
+                Ok(e) => sse_event(e.event, &e),
+                Err(broadcast::error::RecvError::Lagged(_)) => {
+                    // Too far behind to replay: reload everything at the current revision.
+                    let e = EditEvent {
+                        event: "resync",
+                        revision: editing.current().revision,
+                        action: None,
+                        id: None,
+                        chunks: Vec::new(),
+                    };
+                    sse_event(e.event, &e)
+                }
+                Err(broadcast::error::RecvError::Closed) => return None,
+            };
+            Some((Ok(event), (None, rx, editing, stop)))
+        },
+    );
     let mut r = Sse::new(stream)
         .keep_alive(KeepAlive::new().interval(KEEP_ALIVE))
         .into_response();

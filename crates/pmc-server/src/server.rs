@@ -124,6 +124,13 @@ impl Server {
             tracing::info!("editing world {}", e.path().display());
             tokio::spawn(watch_world(self.state.clone()));
         }
+        let state = self.state.clone();
+        let shutdown = async move {
+            shutdown.await;
+            // Event streams never end by themselves: end them, or the graceful shutdown would
+            // wait for every watching browser to close.
+            state.begin_shutdown();
+        };
         let app = router(self.state).into_make_service_with_connect_info::<SocketAddr>();
         axum::serve(self.listener, app).with_graceful_shutdown(shutdown).await?;
         tracing::info!("PMC server stopped");

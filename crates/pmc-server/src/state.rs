@@ -24,6 +24,8 @@ struct Inner {
     editing: Option<Arc<Editing>>,
     /// Navigation grids recently used, most recent last.
     navs: std::sync::Mutex<std::collections::VecDeque<NavEntry>>,
+    /// Set when the server begins to stop: long-lived answers (the event streams) end.
+    stopping: tokio::sync::watch::Sender<bool>,
 }
 
 /// Navigation grids kept besides the world's default one.
@@ -107,9 +109,22 @@ impl AppState {
                 generator: Arc::new(generator),
                 editing,
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
+                stopping: tokio::sync::watch::Sender::new(false),
                 config,
             }),
         })
+    }
+
+    /// Tells long-lived answers (the event streams of `/api/v1/events`) to end, so a graceful
+    /// shutdown does not wait for clients that never hang up. [`Server::run`](crate::Server::run)
+    /// calls it when its shutdown signal completes.
+    pub fn begin_shutdown(&self) {
+        self.inner.stopping.send_replace(true);
+    }
+
+    /// A receiver that turns true when the server begins to stop.
+    pub(crate) fn stopping(&self) -> tokio::sync::watch::Receiver<bool> {
+        self.inner.stopping.subscribe()
     }
 
     /// The settings.

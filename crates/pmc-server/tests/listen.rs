@@ -78,3 +78,46 @@ async fn invalid_limits_are_refused() {
     .unwrap_err();
     assert!(err.to_string().contains("max_planets"), "{err}");
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_watching_browser_does_not_keep_the_server_from_stopping() {
+    let d = std::env::temp_dir().join(format!("pmc-server-listen-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let config = ServerConfig {
+        world: Some(d.join("w.pmcw")),
+        ..small_config()
+    };
+    let server = Server::bind(config).await.unwrap();
+    let addr = server.local_addr();
+    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    let run = tokio::spawn(server.run(async {
+        let _ = stopped.await;
+    }));
+    // A client subscribed to the event stream, which never hangs up by itself.
+    let watcher = tokio::task::spawn_blocking(move || {
+        let mut s = TcpStream::connect(addr).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+        write!(s, "GET /api/v1/events HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+        let mut raw = Vec::new();
+        let mut buf = [0u8; 4096];
+        // Read until the hello event, then until the server closes the stream.
+        loop {
+            match s.read(&mut buf) {
+                Ok(0) => break,
+                Ok(n) => raw.extend_from_slice(&buf[..n]),
+                Err(e) => panic!("the stream was not closed: {e}"),
+            }
+        }
+        String::from_utf8_lossy(&raw).into_owned()
+    });
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    stop.send(()).unwrap();
+    tokio::time::timeout(Duration::from_secs(10), run)
+        .await
+        .expect("the server stops although a client watches the events")
+        .unwrap()
+        .unwrap();
+    let seen = watcher.await.unwrap();
+    assert!(seen.contains("event: hello"), "{seen}");
+}
