@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The main job: builds the viewer and the `pmc` binary (the viewer is embedded in it), then serves
-# the default planet at http://127.0.0.1:8080/. Extra arguments go to `pmc serve`, e.g.
+# the default planet at http://127.0.0.1:8080/, editable, its edits kept in out/world.pmcw
+# (created on first run; delete it to start over). Arguments replace that and go to `pmc serve`:
 #   ./scripts/run.sh --preset mars --seed 3 --port 9000
+#   ./scripts/run.sh --world my.pmcw
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -11,4 +13,8 @@ echo "==> building the viewer (viewer/dist)" >&2
 echo "==> building pmc (release)" >&2
 cargo build --release --locked --bin pmc
 
+if [ $# -eq 0 ]; then
+  mkdir -p out
+  set -- --world out/world.pmcw
+fi
 exec target/release/pmc serve "$@"
