@@ -120,6 +120,54 @@ export interface EditList {
   edits: EditRecord[];
 }
 
+/** One end of a path, as `/path` takes it: degrees, and metres above the datum (null: none given). */
+export interface PathEnd {
+  lat: number;
+  lon: number;
+  alt: number | null;
+}
+
+/** A waypoint of a path: degrees, metres above the planet's datum. */
+export interface PathWaypoint {
+  lat: number;
+  lon: number;
+  alt: number;
+}
+
+/** The answer of `GET /path` (docs/specs/path-v1.md, JSON), the members the viewer reads. */
+export interface PathAnswer {
+  found: boolean;
+  /** Metres walked and steps (when found). */
+  length: number | null;
+  steps: number | null;
+  /** The surface points walked, start and goal included (empty when not found). */
+  waypoints: PathWaypoint[];
+  /** Why there is no path (when not found). */
+  reason: string | null;
+  /** The components of the two ends when they differ (when not found). */
+  components: [number, number] | null;
+  /** The world revision the grid reflects. */
+  revision: number;
+}
+
+/** The answer of `GET /navgrid`: nodes near a point, their components and the steps between them. */
+export interface NavGridAnswer {
+  revision: number;
+  /** The point asked for, planet frame. */
+  origin: Vec3Tuple;
+  /** Three per node, metres, relative to `origin`. */
+  positions: number[];
+  /** Component label per node. */
+  components: number[];
+  /** Node count of each node's component over the whole planet. */
+  component_sizes: number[];
+  /** Pairs of node indices joined by a step. */
+  edges: number[];
+  truncated: boolean;
+  total_nodes: number;
+  total_components: number;
+}
+
 export interface ChunkEntry {
   key: string;
   face: string;
@@ -282,6 +330,23 @@ export class PmcApi {
     return this.json(this.url('stats'), signal);
   }
 
+  // ---- navigation ------------------------------------------------------------------------------
+
+  /**
+   * The walking path between two ends (`GET /path`), each `LAT,LON[,ALT]` (see `formatPathEnd`).
+   * "No path" is an answer (`found` false, with the reason), not an error.
+   */
+  async path(planet: PlanetChoice, from: string, to: string, signal?: AbortSignal): Promise<PathAnswer> {
+    const url = this.url('path', planet, { from, to });
+    return checkPathAnswer(await this.json<unknown>(url, signal), url);
+  }
+
+  /** The grid's nodes within `range` metres of `at` (planet frame), at most `limit` (`GET /navgrid`). */
+  async navgrid(planet: PlanetChoice, at: Vec3Tuple, range: number, limit = 20_000, signal?: AbortSignal): Promise<NavGridAnswer> {
+    const url = this.url('navgrid', planet, { x: at[0], y: at[1], z: at[2], range, limit });
+    return checkNavGrid(await this.json<unknown>(url, signal), url);
+  }
+
   // ---- editing (a server started with `--world`) ---------------------------------------------
 
   /**
@@ -347,5 +412,74 @@ function checkEditAnswer(body: unknown, url: string): EditAnswer {
     active: typeof a.active === 'number' ? a.active : 0,
     redo: typeof a.redo === 'number' ? a.redo : 0,
     chunks: a.chunks,
+  };
+}
+
+const finite = (x: unknown): x is number => typeof x === 'number' && Number.isFinite(x);
+
+/** Checks the members of a `/path` answer the viewer reads. */
+function checkPathAnswer(body: unknown, url: string): PathAnswer {
+  const bad = (why: string): ApiError => new ApiError(`unexpected answer from ${url}: ${why}`, 200, url);
+  const a = body as Record<string, unknown> | null;
+  if (!a || typeof a !== 'object' || typeof a['found'] !== 'boolean') throw bad('no "found"');
+  const found = a['found'];
+  const revision = finite(a['revision']) ? a['revision'] : 0;
+  if (!found) {
+    const c = a['components'];
+    return {
+      found: false,
+      length: null,
+      steps: null,
+      waypoints: [],
+      reason: typeof a['reason'] === 'string' ? a['reason'] : 'no reason given',
+      components: Array.isArray(c) && c.length === 2 && c.every(finite) ? [c[0], c[1]] : null,
+      revision,
+    };
+  }
+  const w = a['waypoints'];
+  if (!Array.isArray(w) || w.length === 0) throw bad('a path found without waypoints');
+  const waypoints: PathWaypoint[] = w.map((p: unknown, i) => {
+    const q = p as Record<string, unknown> | null;
+    if (!q || !finite(q['lat']) || !finite(q['lon']) || !finite(q['alt'])) throw bad(`waypoint ${i} is not {lat, lon, alt}`);
+    return { lat: q['lat'], lon: q['lon'], alt: q['alt'] };
+  });
+  if (!finite(a['length'])) throw bad('a path found without a length');
+  return {
+    found: true,
+    length: a['length'],
+    steps: finite(a['steps']) ? a['steps'] : waypoints.length - 1,
+    waypoints,
+    reason: null,
+    components: null,
+    revision,
+  };
+}
+
+/** Checks a `/navgrid` answer: array lengths agree and every edge names nodes of the answer. */
+function checkNavGrid(body: unknown, url: string): NavGridAnswer {
+  const bad = (why: string): ApiError => new ApiError(`unexpected answer from ${url}: ${why}`, 200, url);
+  const a = body as Partial<NavGridAnswer> | null;
+  if (!a || typeof a !== 'object') throw bad('not an object');
+  const { origin, positions, components, component_sizes: sizes, edges } = a;
+  if (!Array.isArray(origin) || origin.length !== 3 || !origin.every(finite)) throw bad('no origin [x, y, z]');
+  if (!Array.isArray(positions) || positions.length % 3 !== 0) throw bad('positions is not a list of triples');
+  if (!positions.every(finite)) throw bad('a position is not a finite number');
+  const n = positions.length / 3;
+  if (!Array.isArray(components) || components.length !== n) throw bad(`${String(components?.length)} components for ${n} nodes`);
+  if (!Array.isArray(sizes) || sizes.length !== n) throw bad(`${String(sizes?.length)} component sizes for ${n} nodes`);
+  if (!Array.isArray(edges) || edges.length % 2 !== 0) throw bad('edges is not a list of pairs');
+  for (const e of edges) {
+    if (!Number.isInteger(e) || e < 0 || e >= n) throw bad(`edge end ${String(e)} is not a node index below ${n}`);
+  }
+  return {
+    revision: finite(a.revision) ? a.revision : 0,
+    origin: [origin[0], origin[1], origin[2]],
+    positions,
+    components,
+    component_sizes: sizes,
+    edges,
+    truncated: a.truncated === true,
+    total_nodes: finite(a.total_nodes) ? a.total_nodes : n,
+    total_components: finite(a.total_components) ? a.total_components : new Set(components).size,
   };
 }

@@ -20,13 +20,16 @@ import {
 import { ChunkStreamer } from './chunkStreamer';
 import { loadRange } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
-import { toolByName, toolForKey } from './editTools';
+import { toolByName, toolForKey, type ToolName } from './editTools';
 import { addScaled, cameraBasis, enuAt, length, normalize, wrapLon, type V3 } from './frames';
 import { Input } from './input';
+import { NavGridLoader, groundPoint, navRange, type NavGridStatus } from './navOverlay';
+import { NavScene } from './navScene';
+import { PATH_TOOL, PathTool, type PathStatus } from './pathTool';
 import { planetParams, type PlanetParams } from './planetParams';
 import { PlanetScene, type DebugFlags } from './planetScene';
 import { ToolsUi } from './toolsUi';
-import { Ui } from './ui';
+import { Ui, formatDistance } from './ui';
 import { formatHash, parseHash, type UrlState } from './urlState';
 
 export type ModeName = CameraMode | 'walk';
@@ -63,6 +66,33 @@ export interface PmcStats {
   /** Whether the brush cursor is drawn. */
   cursor: boolean;
   edit: EditStatus;
+  /** The Path tool is chosen (the left button picks the path's ends). */
+  pathTool: boolean;
+}
+
+/** `__pmc.path()`: the Path tool's state, and where the path drawn lies on the canvas. */
+export interface PmcPathHook extends Omit<PathStatus, 'waypoints' | 'from' | 'to'> {
+  /** The ends as sent to `/path` (`LAT,LON,ALT`), null when not set. */
+  from: string | null;
+  to: string | null;
+  fromPoint: V3 | null;
+  toPoint: V3 | null;
+  /** Waypoints of the path shown. */
+  waypoints: number;
+  /** The drawn (lifted) waypoints on the canvas, CSS pixels; null where behind the camera. */
+  screen: ([number, number] | null)[];
+  /** The tool is chosen. */
+  active: boolean;
+}
+
+/** `__pmc.navgrid()`: the overlay's state. */
+export interface PmcNavGridHook extends NavGridStatus {
+  /** The overlay's objects are in the scene. */
+  drawn: boolean;
+  /** Per component: its nodes of the overlay in front of the camera and inside the canvas. */
+  onScreen: Record<number, number>;
+  /** Per component but the main one: those of them the loaded terrain does not hide. */
+  visible: Record<number, number>;
 }
 
 /** A point of the loaded terrain under a pixel. */
@@ -86,6 +116,10 @@ export interface PmcTestHook {
   debug(flags: Partial<DebugFlags>): DebugFlags;
   /** The loaded terrain under canvas pixel (x, y) (CSS pixels from the top left), or null. */
   pick(x: number, y: number): PickResult | null;
+  /** The Path tool's state (see PmcPathHook). */
+  path(): PmcPathHook;
+  /** Turns the nav grid overlay on or off when `on` is given; returns its state. */
+  navgrid(on?: boolean): PmcNavGridHook;
 }
 
 declare global {
@@ -103,6 +137,16 @@ export class App {
   private readonly renderer: THREE.WebGLRenderer;
   private readonly camera = new THREE.PerspectiveCamera(FOV, 1, 0.1, 1e5);
   private readonly scene = new PlanetScene();
+  private readonly navScene = new NavScene();
+  private readonly pathTool: PathTool;
+  private readonly navLoader: NavGridLoader;
+  /** The Path tool is chosen (the editor's tool is Look meanwhile). */
+  private pathActive = false;
+  private pathDrawn = -1;
+  private gridDrawn = -1;
+  private navChanged = true;
+  /** The world revision the path and the grid were last asked for. */
+  private navRevision = 0;
   private readonly streamer: ChunkStreamer;
   private readonly ui: Ui;
   private readonly toolsUi: ToolsUi;
@@ -161,6 +205,20 @@ export class App {
         this.scene.setDebug(flags);
         this.ui.setDebug(this.scene.debug());
       },
+      onNavGrid: (on) => this.setNavGrid(on),
+    });
+    this.scene.scene.add(this.navScene.group);
+    this.pathTool = new PathTool({
+      fetchPath: (from, to, signal) => this.api.path(this.choice, from, to, signal),
+      onChange: () => {
+        this.editChanged = true;
+      },
+    });
+    this.navLoader = new NavGridLoader({
+      fetchGrid: (at, range, signal) => this.api.navgrid(this.choice, at, range, 20_000, signal),
+      onChange: () => {
+        this.navChanged = true;
+      },
     });
     this.editor = new EditSession({
       api: this.api,
@@ -171,7 +229,8 @@ export class App {
       },
     });
     this.toolsUi = new ToolsUi({
-      onTool: (tool) => this.editor.setTool(tool),
+      onTool: (tool) => this.chooseTool(tool),
+      onPathTool: () => this.choosePathTool(),
       onRadius: (r) => this.editor.setRadius(r),
       onStrength: (st) => this.editor.setStrength(st),
       onMaterial: (m) => this.editor.setMaterial(m),
@@ -183,11 +242,11 @@ export class App {
       onToggleWalk: () => {
         if (this.mode === 'fly') this.setWalk(!this.walk);
       },
-      brushActive: () => this.editor.brushActive,
+      brushActive: () => this.editor.brushActive || this.pathActive,
       onShortcut: (e) => this.shortcut(e),
     });
     canvas.addEventListener('dblclick', () => {
-      if (this.mode === 'fly' && !this.editor.brushActive) this.input.requestPointerLock();
+      if (this.mode === 'fly' && !this.editor.brushActive && !this.pathActive) this.input.requestPointerLock();
     });
     window.addEventListener('resize', () => this.resize());
     window.addEventListener('hashchange', () => this.onHashChange());
@@ -237,6 +296,9 @@ export class App {
     this.choice = { preset: info.preset, seed: info.seed };
     this.streamer.setPlanet(this.choice);
     this.editor.setPlanet(info);
+    this.pathTool.setPlanet(this.params.shape.datum);
+    this.navLoader.reset();
+    this.navRevision = this.editor.revision ?? 0;
     this.scene.clearChunks();
     this.scene.setPlanet(this.params);
     const shape = this.params.shape;
@@ -375,10 +437,23 @@ export class App {
       return false;
     }
     if (e.altKey) return false;
+    if (e.code === 'Escape' && this.pathTool.active) {
+      // Esc clears the path first (the tool stays), then goes back to Look
+      this.pathTool.clear();
+      return true;
+    }
+    if (e.code === PATH_TOOL.code) {
+      this.choosePathTool();
+      return true;
+    }
+    if (e.code === 'KeyN' && !e.shiftKey) {
+      if (!e.repeat) this.setNavGrid(!this.navLoader.enabled);
+      return true;
+    }
     const tool = toolForKey(e.code);
     if (tool) {
-      if (tool === 'look' && this.editor.currentTool === 'look') return false;
-      this.editor.setTool(tool);
+      if (tool === 'look' && this.editor.currentTool === 'look' && !this.pathActive) return false;
+      this.chooseTool(tool);
       return true;
     }
     if ((e.code === 'BracketLeft' || e.code === 'BracketRight') && this.editor.enabled) {
@@ -386,6 +461,28 @@ export class App {
       return true;
     }
     return false;
+  }
+
+  /** An editing tool (or Look) from the tool bar or its key; leaves the Path tool. */
+  private chooseTool(tool: ToolName): void {
+    this.editor.setTool(tool);
+    // a tool editing is off for is refused (the editor says why): the Path tool stays then
+    if (this.editor.currentTool === tool && this.pathActive) {
+      this.pathActive = false;
+      this.editChanged = true;
+    }
+  }
+
+  /** The Path tool: the left button picks the start, then the goal. No world needed. */
+  private choosePathTool(): void {
+    this.editor.setTool('look');
+    this.pathActive = true;
+    this.editChanged = true;
+  }
+
+  setNavGrid(on: boolean): void {
+    this.navLoader.setEnabled(on);
+    this.navChanged = true;
   }
 
   private readonly ndc = new THREE.Vector2();
@@ -415,6 +512,12 @@ export class App {
 
   /** The brush under the mouse: cursor, press, drag and release. */
   private brushFrame(input: ReturnType<Input['take']>): void {
+    if (this.pathActive) {
+      this.scene.setBrushCursor(null);
+      this.canvas.classList.add('brush');
+      for (const at of input.brushPresses) this.pathTool.click(this.pick(at.x, at.y)?.point ?? null);
+      return;
+    }
     if (!this.editor.brushActive) {
       this.scene.setBrushCursor(null);
       if (input.brushRelease) this.editor.release();
@@ -439,6 +542,94 @@ export class App {
     const push = s.push === 'open' ? 'live' : s.push === 'off' ? 'off' : s.push;
     const counts = s.active !== null ? ` · ${s.active} active${s.redo ? ` · ${s.redo} undone` : ''}` : '';
     return { text: `rev ${s.revision ?? '?'}${counts}`, push };
+  }
+
+  // ---- navigation -----------------------------------------------------------------------------
+
+  /**
+   * The path and the grid overlay: after an edit (a new world revision) ask for the path again
+   * and refresh the grid; fetch the grid around the ground point as the camera moves; redraw what
+   * changed; place it all around the camera.
+   */
+  private navFrame(pos: V3, params: PlanetParams): void {
+    const revision = this.editor.revision ?? 0;
+    if (revision !== this.navRevision) {
+      this.navRevision = revision;
+      this.pathTool.refresh();
+    }
+    if (this.navLoader.enabled) {
+      const ground = groundPoint(pos, this.aboveGround, params.shape.datum);
+      const height = length(pos) - length(ground);
+      this.navLoader.update({
+        planet: `${this.choice.preset ?? ''}/${this.choice.seed ?? ''}`,
+        centre: ground,
+        range: navRange(height),
+        revision,
+      });
+    }
+    if (this.pathDrawn !== this.pathTool.version) {
+      this.pathDrawn = this.pathTool.version;
+      const ps = this.pathTool.status();
+      this.navScene.setPath(ps.waypoints.length >= 2 ? ps.waypoints : null);
+      this.navScene.setMarkers(ps.from?.point ?? null, ps.to?.point ?? null);
+    }
+    if (this.gridDrawn !== this.navLoader.version) {
+      this.gridDrawn = this.navLoader.version;
+      this.navScene.setGrid(this.navLoader.overlay());
+    }
+    this.navScene.place(pos);
+  }
+
+  /** Canvas pixel (CSS) of a planet-frame point with the camera of the last frame; null behind it. */
+  private toScreen(p: V3): [number, number] | null {
+    const cam = this.cameraPos;
+    const v = new THREE.Vector3(p[0] - cam[0], p[1] - cam[1], p[2] - cam[2]);
+    v.applyMatrix4(this.camera.matrixWorldInverse);
+    if (v.z >= 0) return null;
+    v.applyMatrix4(this.camera.projectionMatrix);
+    const w = this.canvas.clientWidth || window.innerWidth;
+    const h = this.canvas.clientHeight || window.innerHeight;
+    return [((v.x + 1) / 2) * w, ((1 - v.y) / 2) * h];
+  }
+
+  private pathHook(): PmcPathHook {
+    const s = this.pathTool.status();
+    const { waypoints: _w, from, to, ...rest } = s;
+    return {
+      ...rest,
+      from: from?.query ?? null,
+      to: to?.query ?? null,
+      fromPoint: from?.point ?? null,
+      toPoint: to?.point ?? null,
+      waypoints: s.waypoints.length,
+      screen: this.navScene.drawnPath().map((p) => this.toScreen(p)),
+      active: this.pathActive,
+    };
+  }
+
+  private navGridHook(): PmcNavGridHook {
+    const st = this.navLoader.status();
+    const onScreen: Record<number, number> = {};
+    const d = this.navLoader.overlay();
+    const w = this.canvas.clientWidth || window.innerWidth;
+    const h = this.canvas.clientHeight || window.innerHeight;
+    const visible: Record<number, number> = {};
+    if (d) {
+      const cam = this.cameraPos;
+      for (let i = 0; i < d.count; i++) {
+        const p: V3 = [d.origin[0] + d.positions[3 * i]!, d.origin[1] + d.positions[3 * i + 1]!, d.origin[2] + d.positions[3 * i + 2]!];
+        const px = this.toScreen(p);
+        if (!px || px[0] < 0 || px[0] >= w || px[1] < 0 || px[1] >= h) continue;
+        const label = d.labels[i]!;
+        onScreen[label] = (onScreen[label] ?? 0) + 1;
+        if (label === d.main) continue;
+        // not hidden by the terrain: nothing nearer along the ray through its pixel
+        const hit = this.pick(px[0], px[1]);
+        const dist = Math.hypot(p[0] - cam[0], p[1] - cam[1], p[2] - cam[2]);
+        if (!hit || hit.distance > dist - 0.5) visible[label] = (visible[label] ?? 0) + 1;
+      }
+    }
+    return { ...st, drawn: this.navScene.gridShown(), onScreen, visible };
   }
 
   // ---- frame loop ---------------------------------------------------------------------------
@@ -478,7 +669,8 @@ export class App {
       this.ui.setLoading(0, 0, this.planetBusy ?? 'waiting for the server');
       if (this.editChanged) {
         this.editChanged = false;
-        this.toolsUi.update(this.editor.status());
+        this.toolsUi.update(this.editor.status(), this.pathActive);
+        this.toolsUi.setPath(this.pathTool.status(), this.pathActive);
       }
       return;
     }
@@ -558,6 +750,7 @@ export class App {
     this.camera.updateProjectionMatrix();
     this.cameraPos = pos;
     this.brushFrame(input);
+    this.navFrame(pos, params);
 
     // sky: blue near the ground, black from orbit
     const aboveSea = r - (params.seaRadius ?? shape.datum);
@@ -611,7 +804,14 @@ export class App {
     }
     if (this.editChanged) {
       this.editChanged = false;
-      this.toolsUi.update(this.editor.status());
+      this.toolsUi.update(this.editor.status(), this.pathActive);
+      const ps = this.pathTool.status();
+      this.toolsUi.setPath(ps, this.pathActive);
+      this.ui.setPathStats(pathStatsText(ps));
+    }
+    if (this.navChanged) {
+      this.navChanged = false;
+      this.ui.setNavGrid(this.navLoader.status());
     }
     if (moved) this.writeHash(false);
   }
@@ -660,6 +860,7 @@ export class App {
       reloads: st.reloads,
       cursor: this.scene.brushCursorVisible(),
       edit: this.editor.status(),
+      pathTool: this.pathActive,
     };
   }
 
@@ -700,6 +901,29 @@ export class App {
         const p = this.pick(x, y);
         return p ? { distance: p.distance, point: p.point, key: p.key } : null;
       },
+      path: () => this.pathHook(),
+      navgrid: (on) => {
+        if (on !== undefined) this.setNavGrid(on);
+        return this.navGridHook();
+      },
     };
+  }
+}
+
+/** The path row of the stats panel. */
+function pathStatsText(s: PathStatus): string {
+  switch (s.phase) {
+    case 'empty':
+      return '–';
+    case 'start':
+      return 'start set';
+    case 'loading':
+      return 'finding…';
+    case 'found':
+      return `${formatDistance(s.length!)} · ${s.steps} step${s.steps === 1 ? '' : 's'}`;
+    case 'none':
+      return 'no path';
+    case 'error':
+      return 'error';
   }
 }

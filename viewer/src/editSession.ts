@@ -192,6 +192,11 @@ export class EditSession {
     return this.enabled && this.tool !== 'look';
   }
 
+  /** The last world revision seen (answers and push), null when editing is off. */
+  get revision(): number | null {
+    return this.tracker?.revision ?? null;
+  }
+
   get currentTool(): ToolName {
     return this.tool;
   }

@@ -13,6 +13,8 @@ export interface InputFrame {
   fast: boolean;
   /** With a brush tool: where the left button went down (canvas pixels) since the last frame. */
   brushPress: { x: number; y: number } | null;
+  /** Every such press since the last frame, in order (two quick clicks can fall in one frame). */
+  brushPresses: { x: number; y: number }[];
   /** With a brush tool: the left button went up since the last frame (after `brushPress`). */
   brushRelease: boolean;
 }
@@ -52,7 +54,7 @@ export class Input {
   private lastX = 0;
   private lastY = 0;
   private brushing = false;
-  private brushPress: { x: number; y: number } | null = null;
+  private brushPresses: { x: number; y: number }[] = [];
   private brushRelease = false;
   /** The mouse over the canvas (canvas pixels), or null when it is elsewhere. */
   private hover: { x: number; y: number } | null = null;
@@ -76,7 +78,7 @@ export class Input {
       this.hover = this.local(e);
       if (e.button === 0 && this.callbacks.brushActive?.()) {
         this.brushing = true;
-        this.brushPress = this.local(e);
+        this.brushPresses.push(this.local(e));
         this.brushRelease = false;
       } else {
         this.dragging = true;
@@ -215,10 +217,11 @@ export class Input {
       right: axis(RIGHT, LEFT),
       up: axis(UP, DOWN),
       fast: this.held.has('ControlLeft') || this.held.has('AltLeft'),
-      brushPress: this.brushPress,
+      brushPress: this.brushPresses[0] ?? null,
+      brushPresses: this.brushPresses,
       brushRelease: this.brushRelease,
     };
-    this.brushPress = null;
+    this.brushPresses = [];
     this.brushRelease = false;
     this.dragX = 0;
     this.dragY = 0;

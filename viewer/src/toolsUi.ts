@@ -1,11 +1,15 @@
-// The editing panel of index.html: tool bar, brush radius and strength, paint material, undo and
-// redo, and the status line (why editing is off, the last error). Plain DOM.
+// The tools panel of index.html: tool bar (the editing tools and Path), brush radius and
+// strength, paint material, undo and redo, the status line (why editing is off, the last error)
+// and the Path tool's line (its ends, the length found, no path and why). Plain DOM.
 
 import { TOOLS, MIN_STRENGTH, type ToolName } from './editTools';
 import type { EditStatus } from './editSession';
+import { PATH_TOOL, type PathStatus } from './pathTool';
 
 export interface ToolsUiCallbacks {
   onTool(tool: ToolName): void;
+  /** The Path button. */
+  onPathTool(): void;
   onRadius(r: number): void;
   onStrength(s: number): void;
   onMaterial(m: string): void;
@@ -34,6 +38,8 @@ export class ToolsUi {
   private readonly undoButton = byId<HTMLButtonElement>('undo');
   private readonly redoButton = byId<HTMLButtonElement>('redo');
   private readonly statusLine = byId<HTMLParagraphElement>('tools-status');
+  private readonly pathLine = byId<HTMLParagraphElement>('path-status');
+  private readonly pathButton: HTMLButtonElement;
   private readonly buttons = new Map<ToolName, HTMLButtonElement>();
   private limits = { min: 0.5, max: 64 };
   private shownMaterials = '';
@@ -54,6 +60,20 @@ export class ToolsUi {
       this.bar.append(b);
       this.buttons.set(t.name, b);
     }
+    // Path: no world needed, never disabled
+    const pb = document.createElement('button');
+    pb.type = 'button';
+    pb.id = 'tool-path';
+    pb.textContent = PATH_TOOL.label;
+    pb.dataset['tool'] = 'path';
+    pb.setAttribute('aria-pressed', 'false');
+    pb.title = `${PATH_TOOL.label} (${PATH_TOOL.key}): ${PATH_TOOL.help}; Esc clears`;
+    pb.addEventListener('click', () => {
+      this.callbacks.onPathTool();
+      pb.blur();
+    });
+    this.bar.append(pb);
+    this.pathButton = pb;
     this.radiusRange.min = '0';
     this.radiusRange.max = String(SLIDER_STEPS);
     this.radiusRange.step = '1';
@@ -96,13 +116,15 @@ export class ToolsUi {
     return Math.round((SLIDER_STEPS * Math.log(r / min)) / Math.log(max / min));
   }
 
-  /** Shows `s` (call whenever the session changed). */
-  update(s: EditStatus): void {
+  /** Shows `s` (call whenever the session changed); `pathActive`: the Path tool is chosen. */
+  update(s: EditStatus, pathActive = false): void {
     const off = !s.enabled;
     this.panel.classList.toggle('disabled', off);
     const why = off ? `editing is off: ${s.reason ?? ''}` : '';
+    this.pathButton.classList.toggle('active', pathActive);
+    this.pathButton.setAttribute('aria-pressed', String(pathActive));
     for (const [name, b] of this.buttons) {
-      const on = name === s.tool;
+      const on = name === s.tool && !pathActive;
       b.classList.toggle('active', on);
       b.setAttribute('aria-pressed', String(on));
       b.disabled = off && name !== 'look';
@@ -157,11 +179,26 @@ export class ToolsUi {
       kind = 'error';
     } else if (s.notice) {
       text = s.notice;
-    } else if (s.tool !== 'look') {
+    } else if (s.tool !== 'look' && !pathActive) {
       text = 'left button: apply (hold and drag to repeat) · right drag: camera';
     }
     this.statusLine.textContent = text;
     this.statusLine.dataset['kind'] = kind;
     this.statusLine.hidden = text === '';
+  }
+
+  /**
+   * The Path tool's line: shown while the tool is chosen or a path (or its start) is shown;
+   * errors in the error colour.
+   */
+  setPath(p: PathStatus, pathActive: boolean): void {
+    const show = pathActive || p.phase !== 'empty' || p.notice !== null;
+    let text = p.message;
+    if (pathActive && (p.phase === 'found' || p.phase === 'none' || p.phase === 'error')) text += ' · click again to start over, Esc clears';
+    else if (!pathActive && p.phase !== 'empty') text += ' · Esc clears';
+    this.pathLine.textContent = show ? text : '';
+    this.pathLine.dataset['kind'] = p.phase === 'error' ? 'error' : p.phase === 'none' ? 'none' : p.phase === 'found' ? 'found' : '';
+    this.pathLine.dataset['phase'] = p.phase;
+    this.pathLine.hidden = !show;
   }
 }

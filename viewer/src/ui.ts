@@ -4,12 +4,15 @@
 import type { CameraMode } from './cameraModel';
 import type { PresetInfo } from './api';
 import type { DebugFlags } from './planetScene';
+import type { NavGridStatus } from './navOverlay';
 
 export interface UiCallbacks {
   onPlanet(preset: string, seed: string): void;
   onMode(mode: CameraMode): void;
   onWalk(walk: boolean): void;
   onDebug(flags: Partial<DebugFlags>): void;
+  /** The nav grid checkbox. */
+  onNavGrid(on: boolean): void;
 }
 
 export interface StatsView {
@@ -49,6 +52,9 @@ export class Ui {
   private readonly wireframe = byId<HTMLInputElement>('wireframe');
   private readonly faces = byId<HTMLInputElement>('faces');
   private readonly borders = byId<HTMLInputElement>('borders');
+  private readonly navgrid = byId<HTMLInputElement>('navgrid');
+  private readonly navgridStatus = byId<HTMLParagraphElement>('navgrid-status');
+  private shownNavGrid = '';
   private readonly loading = byId<HTMLDivElement>('loading');
   private readonly loadingText = byId<HTMLSpanElement>('loading-text');
   private readonly error = byId<HTMLDivElement>('error');
@@ -67,6 +73,7 @@ export class Ui {
     edits: byId('s-edits'),
     push: byId('s-push'),
     editError: byId('s-edit-error'),
+    path: byId('s-path'),
   };
   private mode: CameraMode = 'orbit';
 
@@ -90,6 +97,10 @@ export class Ui {
     this.borders.addEventListener('change', () =>
       this.callbacks.onDebug({ borders: this.borders.checked }),
     );
+    this.navgrid.addEventListener('change', () => {
+      this.callbacks.onNavGrid(this.navgrid.checked);
+      this.navgrid.blur();
+    });
     byId('error-close').addEventListener('click', () => this.clearError());
   }
 
@@ -135,6 +146,58 @@ export class Ui {
     this.wireframe.checked = flags.wireframe;
     this.faces.checked = flags.faceColours;
     this.borders.checked = flags.borders;
+  }
+
+  /**
+   * The nav grid checkbox and its line: nodes and components in view, a legend (the main grid's
+   * colour and the other components' colours), or the error.
+   */
+  setNavGrid(s: NavGridStatus): void {
+    this.navgrid.checked = s.enabled;
+    const key = JSON.stringify([s.enabled, s.loading, s.error, s.nodes, s.fetches, s.truncated, s.components.length]);
+    if (key === this.shownNavGrid) return;
+    this.shownNavGrid = key;
+    const el = this.navgridStatus;
+    el.hidden = !s.enabled;
+    el.dataset['kind'] = s.error ? 'error' : '';
+    if (!s.enabled) {
+      el.replaceChildren();
+      return;
+    }
+    if (s.error) {
+      el.textContent = s.error;
+      return;
+    }
+    if (s.nodes === 0) {
+      el.textContent = s.loading ? 'loading the navigation grid…' : 'no walkable ground in range';
+      return;
+    }
+    const swatch = (hex: string, title: string): HTMLElement => {
+      const sp = document.createElement('span');
+      sp.className = 'swatch';
+      sp.style.background = hex;
+      sp.title = title;
+      return sp;
+    };
+    const others = s.components.filter((c) => !c.main);
+    const main = s.components.find((c) => c.main);
+    const parts: (HTMLElement | string)[] = [
+      `${fmtInt(s.nodes)} nodes${s.truncated ? ' (the nearest only)' : ''}, ${s.components.length} component${s.components.length === 1 ? '' : 's'}${s.loading ? ' · updating' : ''}`,
+      document.createElement('br'),
+    ];
+    if (main) parts.push(swatch(main.hex, `${fmtInt(main.size)} nodes`), ' main grid ');
+    if (others.length > 0) {
+      for (const c of others.slice(0, 8)) parts.push(swatch(c.hex, `component ${c.label}: ${fmtInt(c.size)} nodes, ${c.nodes} here`));
+      parts.push(` ${others.length} detached`);
+    } else {
+      parts.push('nothing detached here');
+    }
+    el.replaceChildren(...parts);
+  }
+
+  /** The path row of the stats panel. */
+  setPathStats(text: string): void {
+    this.fields.path.textContent = text;
   }
 
   setLoading(pending: number, missing: number, busyText: string | null): void {

@@ -100,6 +100,21 @@ describe('Input', () => {
     input.dispose();
   });
 
+  it('keeps every press of one frame, in order (two quick clicks of the Path tool)', () => {
+    const { canvas, input } = setup({ active: true });
+    canvas.dispatchEvent(pointer('pointerdown', 0, 110, 120));
+    canvas.dispatchEvent(pointer('pointerup', 0, 110, 120));
+    canvas.dispatchEvent(pointer('pointerdown', 0, 310, 220));
+    canvas.dispatchEvent(pointer('pointerup', 0, 310, 220));
+    let f = input.take();
+    expect(f.brushPresses).toEqual([{ x: 100, y: 100 }, { x: 300, y: 200 }]);
+    expect(f.brushPress).toEqual({ x: 100, y: 100 });
+    expect(f.brushRelease).toBe(true);
+    f = input.take();
+    expect([f.brushPresses, f.brushPress]).toEqual([[], null]);
+    input.dispose();
+  });
+
   it('gives shortcuts first say, and Shift inside a Ctrl chord does not fly down', () => {
     const { input, shortcuts, win } = setup({ active: false });
     win.dispatchEvent(key('keydown', 'ControlLeft', { ctrlKey: true }));

@@ -15,7 +15,7 @@ use serde_json::{json, Value};
 
 /// Columns searched around each end of a path for walkable ground.
 pub const SNAP_RINGS: usize = 8;
-/// Default and largest `limit` of `/navgrid`.
+/// Default `limit` of `/navgrid`.
 pub const DEFAULT_NAV_LIMIT: usize = 20_000;
 /// Largest `limit` of `/navgrid`.
 pub const MAX_NAV_LIMIT: usize = 100_000;
@@ -139,17 +139,20 @@ pub async fn navgrid(State(state): State<AppState>, RawQuery(q): RawQuery) -> Re
         let index: std::collections::HashMap<NodeId, usize> = nodes.iter().enumerate().map(|(i, n)| (*n, i)).collect();
         let mut positions = Vec::with_capacity(nodes.len() * 3);
         let mut components = Vec::with_capacity(nodes.len());
-        let mut edges = Vec::new();
+        // Each pair joined by a step either way, once (an agent with different step limits up
+        // and down has steps that go one way only).
+        let mut pairs = std::collections::BTreeSet::new();
         for (i, n) in nodes.iter().enumerate() {
             let q = grid.position(*n).unwrap_or(p) - p;
             positions.extend([q.x, q.y, q.z]);
             components.push(grid.component(*n).unwrap_or(u32::MAX));
             for s in grid.steps(*n) {
-                if let Some(j) = index.get(&s.to).filter(|j| **j > i) {
-                    edges.extend([i as u32, *j as u32]);
+                if let Some(j) = index.get(&s.to) {
+                    pairs.insert((i.min(*j) as u32, i.max(*j) as u32));
                 }
             }
         }
+        let edges: Vec<u32> = pairs.into_iter().flat_map(|(i, j)| [i, j]).collect();
         let sizes: Vec<u32> = components
             .iter()
             .map(|c| grid.component_sizes().get(*c as usize).copied().unwrap_or(0))

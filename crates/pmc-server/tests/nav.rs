@@ -120,6 +120,36 @@ async fn navgrid_lists_the_nodes_near_a_point_with_components_and_steps() {
         assert!(i < j && j < nodes.len());
         assert!(grid.steps(nodes[i]).iter().any(|s| s.to == nodes[j]));
     }
+    // Every step between nodes of the answer is there (the default agent's steps go both ways).
+    let pairs: usize = nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| grid.steps(*n).iter().filter(|s| nodes[i + 1..].contains(&s.to)).count())
+        .sum();
+    assert_eq!(edges.len() / 2, pairs);
+    // An agent that climbs nothing but drops 8 m has one-way steps; they are listed too.
+    let one_way = Agent {
+        step_up: 0.0,
+        ..Agent::default()
+    };
+    let g1 = NavGrid::build(planet.density().as_ref(), planet.layout(), one_way).unwrap();
+    let v1 = get(&a, &format!("{uri}&step_up=0")).await.json();
+    let (n1, _) = g1.nodes_near(p, 40.0, usize::MAX);
+    let mut want = std::collections::BTreeSet::new();
+    for (i, n) in n1.iter().enumerate() {
+        for s in g1.steps(*n) {
+            if let Some(j) = n1.iter().position(|m| *m == s.to) {
+                want.insert((i.min(j) as u64, i.max(j) as u64));
+            }
+        }
+    }
+    let got: std::collections::BTreeSet<(u64, u64)> = v1["edges"]
+        .as_array()
+        .unwrap()
+        .chunks(2)
+        .map(|e| (e[0].as_u64().unwrap(), e[1].as_u64().unwrap()))
+        .collect();
+    assert_eq!(got, want);
     let v = get(&a, &format!("{uri}&limit=2")).await.json();
     assert_eq!(
         (v["positions"].as_array().unwrap().len(), v["truncated"].as_bool()),
