@@ -113,6 +113,30 @@ impl Params {
         }
     }
 
+    /// A required finite number of metres above 0 (a search range).
+    pub(crate) fn range(&self, name: &str) -> Result<f64, ApiError> {
+        let range = self.finite(name)?;
+        if range <= 0.0 {
+            return Err(ApiError::bad_request(format!(
+                "{name} must be above 0 metres, got {range}"
+            )));
+        }
+        Ok(range)
+    }
+
+    /// The optional `limit`: an integer from 1 to `max`, `default` when absent.
+    pub(crate) fn limit(&self, default: usize, max: usize) -> Result<usize, ApiError> {
+        match self.get("limit") {
+            None => Ok(default),
+            Some(s) => match s.trim().parse::<usize>() {
+                Ok(n) if (1..=max).contains(&n) => Ok(n),
+                _ => Err(ApiError::bad_request(format!(
+                    "limit must be an integer from 1 to {max}, got '{s}'"
+                ))),
+            },
+        }
+    }
+
     /// The planet the request names (or the server's).
     pub(crate) fn planet(&self, state: &AppState) -> Result<PlanetId, ApiError> {
         let c = state.config();
@@ -196,23 +220,8 @@ pub async fn chunks(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
     let params = Params::parse(q);
     let id = params.planet(&state)?;
     let p = DVec3::new(params.finite("x")?, params.finite("y")?, params.finite("z")?);
-    let range = params.finite("range")?;
-    if range <= 0.0 {
-        return Err(ApiError::bad_request(format!(
-            "range must be above 0 metres, got {range}"
-        )));
-    }
-    let limit = match params.get("limit") {
-        None => DEFAULT_LIMIT,
-        Some(s) => match s.trim().parse::<usize>() {
-            Ok(n) if (1..=MAX_LIMIT).contains(&n) => n,
-            _ => {
-                return Err(ApiError::bad_request(format!(
-                    "limit must be an integer from 1 to {MAX_LIMIT}, got '{s}'"
-                )))
-            }
-        },
-    };
+    let range = params.range("range")?;
+    let limit = params.limit(DEFAULT_LIMIT, MAX_LIMIT)?;
     let max_level = state.config().layout.max_level();
     let level = match params.get("level") {
         None => 0,

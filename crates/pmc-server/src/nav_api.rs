@@ -116,23 +116,8 @@ pub async fn navgrid(State(state): State<AppState>, RawQuery(q): RawQuery) -> Re
     let id = params.planet(&state)?;
     let agent = agent(&params)?;
     let p = DVec3::new(params.finite("x")?, params.finite("y")?, params.finite("z")?);
-    let range = params.finite("range")?;
-    if range <= 0.0 {
-        return Err(ApiError::bad_request(format!(
-            "range must be above 0 metres, got {range}"
-        )));
-    }
-    let limit = match params.get("limit") {
-        None => DEFAULT_NAV_LIMIT,
-        Some(s) => match s.trim().parse::<usize>() {
-            Ok(n) if (1..=MAX_NAV_LIMIT).contains(&n) => n,
-            _ => {
-                return Err(ApiError::bad_request(format!(
-                    "limit must be an integer from 1 to {MAX_NAV_LIMIT}, got '{s}'"
-                )))
-            }
-        },
-    };
+    let range = params.range("range")?;
+    let limit = params.limit(DEFAULT_NAV_LIMIT, MAX_NAV_LIMIT)?;
     let (grid, _, revision) = state.nav_grid(id, agent).await.map_err(ApiError::internal)?;
     let doc = tokio::task::spawn_blocking(move || {
         let (nodes, truncated) = grid.nodes_near(p, range, limit);
