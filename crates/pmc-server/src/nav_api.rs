@@ -92,7 +92,7 @@ pub async fn path(State(state): State<AppState>, RawQuery(q): RawQuery) -> Resul
     // Checked before any grid is built.
     let datum_probe = state.planet(id).await.map_err(ApiError::internal)?.0.datum_radius();
     let (from, to) = (end(&params, "from", datum_probe)?, end(&params, "to", datum_probe)?);
-    let (grid, planet, revision) = state.nav_grid(id, agent).await.map_err(ApiError::internal)?;
+    let (grid, planet, revision) = state.nav_grid(id, agent).await?;
     let datum = planet.datum_radius();
     let doc = tokio::task::spawn_blocking(move || {
         let answer = query(&grid, from, to, SNAP_RINGS);
@@ -118,7 +118,7 @@ pub async fn navgrid(State(state): State<AppState>, RawQuery(q): RawQuery) -> Re
     let p = DVec3::new(params.finite("x")?, params.finite("y")?, params.finite("z")?);
     let range = params.range("range")?;
     let limit = params.limit(DEFAULT_NAV_LIMIT, MAX_NAV_LIMIT)?;
-    let (grid, _, revision) = state.nav_grid(id, agent).await.map_err(ApiError::internal)?;
+    let (grid, _, revision) = state.nav_grid(id, agent).await?;
     let doc = tokio::task::spawn_blocking(move || {
         let (nodes, truncated) = grid.nodes_near(p, range, limit);
         let index: std::collections::HashMap<NodeId, usize> = nodes.iter().enumerate().map(|(i, n)| (*n, i)).collect();

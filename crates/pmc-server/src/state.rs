@@ -203,8 +203,9 @@ impl AppState {
         &self,
         id: PlanetId,
         agent: Agent,
-    ) -> Result<(Arc<NavGrid>, Arc<Planet>, u64), String> {
-        let (planet, revision) = self.planet(id).await?;
+    ) -> Result<(Arc<NavGrid>, Arc<Planet>, u64), crate::api::ApiError> {
+        use crate::api::ApiError;
+        let (planet, revision) = self.planet(id).await.map_err(ApiError::internal)?;
         let world = self.editing_of(id).filter(|_| agent == Agent::default()).cloned();
         if let Some(g) = world.as_ref().and_then(|e| e.nav_grid(revision)) {
             return Ok((g, planet, revision));
@@ -225,8 +226,10 @@ impl AppState {
         let p = Arc::clone(&planet);
         let grid = tokio::task::spawn_blocking(move || NavGrid::build(p.density().as_ref(), p.layout(), agent))
             .await
-            .map_err(|e| format!("building the navigation grid failed: {e}"))?
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| ApiError::internal(format!("building the navigation grid failed: {e}")))?
+            // Invalid agent limits are checked before, so this is a planet too large for a grid:
+            // a limit of the request, not a failure.
+            .map_err(|e| ApiError::bad_request(e.to_string()))?;
         let grid = Arc::new(grid);
         match world {
             Some(e) => e.keep_nav_grid(revision, Arc::clone(&grid)),

@@ -198,3 +198,17 @@ async fn a_worlds_grid_follows_its_edits() {
     let undone = get(&a, uri).await.json();
     assert_eq!((undone["revision"].as_u64(), path(&undone)), (Some(2), path(&before)));
 }
+
+#[tokio::test]
+async fn a_planet_too_large_for_a_grid_gets_a_400_that_says_so() {
+    let config = ServerConfig {
+        layout: pmc_geometry::Layout::new(128, 32, 1000.0, 1.0, 1).unwrap(),
+        ..small_config()
+    };
+    let a = router(AppState::new(config).unwrap());
+    for uri in ["/api/v1/path?from=1,1&to=2,2", "/api/v1/navgrid?x=0&y=1100&z=0&range=5"] {
+        let r = get(&a, uri).await;
+        assert_eq!(r.status, StatusCode::BAD_REQUEST, "{uri}");
+        assert!(r.json()["error"].as_str().unwrap().contains("columns"), "{uri}");
+    }
+}
