@@ -56,12 +56,12 @@ fn start(extra: &[&str]) -> (Running, SocketAddr) {
     (running, addr)
 }
 
-/// One HTTP/1.1 GET with `Connection: close`: status code and body (servers answer these
-/// without chunked encoding or compression).
-fn http_get(addr: SocketAddr, path: &str) -> (u16, Vec<u8>) {
+/// Sends one HTTP/1.1 request (with `Connection: close`) and reads the status code and body
+/// (servers answer these without chunked encoding or compression).
+fn http_exchange(addr: SocketAddr, request: &str) -> (u16, Vec<u8>) {
     let mut s = TcpStream::connect_timeout(&addr, Duration::from_secs(10)).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
-    write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n").unwrap();
+    s.write_all(request.as_bytes()).unwrap();
     let mut raw = Vec::new();
     s.read_to_end(&mut raw).unwrap();
     let split = raw.windows(4).position(|w| w == b"\r\n\r\n").expect("a header block");
@@ -76,6 +76,14 @@ fn http_get(addr: SocketAddr, path: &str) -> (u16, Vec<u8>) {
         .and_then(|c| c.parse().ok())
         .expect("a status code");
     (code, raw[split + 4..].to_vec())
+}
+
+/// One GET.
+fn http_get(addr: SocketAddr, path: &str) -> (u16, Vec<u8>) {
+    http_exchange(
+        addr,
+        &format!("GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"),
+    )
 }
 
 #[test]
@@ -186,26 +194,15 @@ fn dir(test: &str) -> std::path::PathBuf {
     d
 }
 
-/// One HTTP/1.1 POST of a JSON body: status code and body.
+/// One POST of a JSON body.
 fn http_post(addr: SocketAddr, path: &str, json: &str) -> (u16, Vec<u8>) {
-    let mut s = TcpStream::connect_timeout(&addr, Duration::from_secs(10)).unwrap();
-    s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
-    write!(
-        s,
-        "POST {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{json}",
-        json.len()
+    http_exchange(
+        addr,
+        &format!(
+            "POST {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{json}",
+            json.len()
+        ),
     )
-    .unwrap();
-    let mut raw = Vec::new();
-    s.read_to_end(&mut raw).unwrap();
-    let split = raw.windows(4).position(|w| w == b"\r\n\r\n").expect("a header block");
-    let head = String::from_utf8_lossy(&raw[..split]).into_owned();
-    let code = head
-        .split_whitespace()
-        .nth(1)
-        .and_then(|c| c.parse().ok())
-        .expect("a status code");
-    (code, raw[split + 4..].to_vec())
 }
 
 fn json_of(body: &[u8]) -> serde_json::Value {

@@ -73,6 +73,8 @@ struct Tile {
     local_sizes: Vec<u32>,
     /// Steps that leave the tile.
     border: Vec<BorderStep>,
+    /// Smallest radius of its nodes' surface points (infinite without nodes).
+    min_radius: f64,
 }
 
 /// A step out of a tile: (local node, tile index, local node there).
@@ -306,11 +308,7 @@ impl NavGrid {
         }
         base.push(total);
         self.tile_base = base;
-        self.min_radius = self
-            .tiles
-            .iter()
-            .flat_map(|t| t.nodes.iter().map(|n| n.radius))
-            .fold(f64::INFINITY, f64::min);
+        self.min_radius = self.tiles.iter().map(|t| t.min_radius).fold(f64::INFINITY, f64::min);
         // Steps inside the rebuilt tiles.
         let inside: Vec<(usize, Vec<u32>, Vec<u32>)> = rebuilt
             .par_iter()
@@ -491,10 +489,12 @@ impl NavGrid {
             }
         }
         starts.push(nodes.len() as u32);
+        let min_radius = nodes.iter().map(|n| n.radius).fold(f64::INFINITY, f64::min);
         let tile = Tile {
             columns,
             starts,
             nodes,
+            min_radius,
             ..Tile::default()
         };
         (tile, bits)

@@ -213,11 +213,10 @@ impl AppState {
         let key = agent_key(&agent);
         {
             let mut navs = self.inner.navs.lock().unwrap_or_else(PoisonError::into_inner);
-            if let Some(at) = navs
+            let at = navs
                 .iter()
-                .position(|e| e.planet == id && e.revision == revision && e.agent == key)
-            {
-                let e = navs.remove(at).expect("found above");
+                .position(|e| e.planet == id && e.revision == revision && e.agent == key);
+            if let Some(e) = at.and_then(|at| navs.remove(at)) {
                 let g = Arc::clone(&e.grid);
                 navs.push_back(e);
                 return Ok((g, planet, revision));
