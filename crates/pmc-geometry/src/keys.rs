@@ -44,6 +44,113 @@ impl ChunkKey {
     }
 }
 
+impl ChunkKey {
+    /// The level-`level + 1` chunk holding this one (its parent in the face's octree).
+    pub fn parent(&self) -> ChunkKey {
+        ChunkKey {
+            face: self.face,
+            level: self.level + 1,
+            i: self.i / 2,
+            j: self.j / 2,
+            k: self.k / 2,
+        }
+    }
+
+    /// The eight level-`level - 1` chunks this one covers (children in the face's octree), in
+    /// key order; `None` at level 0. Children past the shell's depth are included: check them
+    /// with [`Layout::contains_chunk`](crate::Layout::contains_chunk).
+    pub fn children(&self) -> Option<[ChunkKey; 8]> {
+        let level = self.level.checked_sub(1)?;
+        Some(std::array::from_fn(|n| ChunkKey {
+            face: self.face,
+            level,
+            i: 2 * self.i + (n as u32 >> 2 & 1),
+            j: 2 * self.j + (n as u32 >> 1 & 1),
+            k: 2 * self.k + (n as u32 & 1),
+        }))
+    }
+}
+
+/// One of the six sides of a chunk, named in its face's local axes: `u`, `v` and depth (inner
+/// towards the planet's centre, outer away from it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ChunkSide {
+    /// The side at the smallest `u` index (`i0`).
+    UMin,
+    /// The side at the largest `u` index.
+    UMax,
+    /// The side at the smallest `v` index.
+    VMin,
+    /// The side at the largest `v` index.
+    VMax,
+    /// The innermost layer (smallest depth index).
+    Inner,
+    /// The outermost layer.
+    Outer,
+}
+
+impl ChunkSide {
+    /// The six sides, in bit order of [`SideMask`].
+    pub const ALL: [ChunkSide; 6] = [
+        ChunkSide::UMin,
+        ChunkSide::UMax,
+        ChunkSide::VMin,
+        ChunkSide::VMax,
+        ChunkSide::Inner,
+        ChunkSide::Outer,
+    ];
+
+    /// The side's bit in a [`SideMask`].
+    pub fn bit(self) -> u8 {
+        1 << (self as u8)
+    }
+
+    /// The local axis the side is perpendicular to: 0 for `u`, 1 for `v`, 2 for depth.
+    pub fn axis(self) -> usize {
+        (self as usize) / 2
+    }
+
+    /// Whether the side is at the largest index of its axis.
+    pub fn is_max(self) -> bool {
+        (self as u8) % 2 == 1
+    }
+}
+
+/// A set of [`ChunkSide`]s, one bit each (bit `n` is `ChunkSide::ALL[n]`).
+///
+/// Level-of-detail meshing uses it for the sides of a chunk across which the selected
+/// neighbour is one level coarser: the chunk then closes the seam there (see
+/// `pmc_mesh::Mesher::mesh_with_transitions`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SideMask(pub u8);
+
+impl SideMask {
+    /// No side.
+    pub const NONE: SideMask = SideMask(0);
+    /// Every side.
+    pub const ALL: SideMask = SideMask(0x3f);
+
+    /// Whether `side` is in the set.
+    pub fn contains(self, side: ChunkSide) -> bool {
+        self.0 & side.bit() != 0
+    }
+
+    /// The set with `side` added.
+    pub fn with(self, side: ChunkSide) -> SideMask {
+        SideMask(self.0 | side.bit())
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 & 0x3f == 0
+    }
+
+    /// The sides in the set, in bit order.
+    pub fn sides(self) -> impl Iterator<Item = ChunkSide> {
+        ChunkSide::ALL.into_iter().filter(move |s| self.contains(*s))
+    }
+}
+
 impl std::fmt::Display for ChunkKey {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/L{}/{}_{}_{}", self.face, self.level, self.i, self.j, self.k)

@@ -3,7 +3,7 @@
 
 use crate::cube_sphere::cube_to_sphere;
 use crate::face::Face;
-use crate::keys::{ChunkKey, VoxelKey};
+use crate::keys::{ChunkKey, ChunkSide, VoxelKey};
 use glam::{DVec3, IVec3};
 
 /// Largest number of tiles along a face edge or the depth axis (keeps lattice keys in 32 bits).
@@ -159,10 +159,19 @@ impl Layout {
         self.d_b + self.l_d * k as f64
     }
 
-    /// The highest level of detail whose chunks tile the planet exactly: `2^L` must divide both
-    /// `n_c` and `d_c`.
+    /// The coarsest level of detail: the largest `L` with `2^L` dividing `n_c`, or 0 when `n_t`
+    /// is odd (a level-`L + 1` voxel must be a level-`L` voxel, which needs chunk origins on even
+    /// level-`L` indices).
+    ///
+    /// A level-`L` chunk covers `2^L` level-0 chunks along every axis with the same `n_t^3` tiles
+    /// (stride `2^L`): an octree per face that also covers depth. Along the face the chunks tile
+    /// it exactly; along depth there are `ceil(d_c / 2^L)` of them, so the outermost may reach
+    /// past the shell's top layer `D`, where the shell contract makes every voxel air.
     pub fn max_level(&self) -> u8 {
-        self.n_c.trailing_zeros().min(self.d_c.trailing_zeros()) as u8
+        if self.n_t % 2 == 1 {
+            return 0;
+        }
+        self.n_c.trailing_zeros() as u8
     }
 
     /// Chunks per face side at `level`.
@@ -170,9 +179,15 @@ impl Layout {
         self.n_c >> level
     }
 
-    /// Chunks along depth at `level`.
+    /// Chunks along depth at `level`: `ceil(d_c / 2^level)`.
     pub fn depth_chunks(&self, level: u8) -> u32 {
-        self.d_c >> level
+        let step = 1u64 << level;
+        (u64::from(self.d_c).div_ceil(step)) as u32
+    }
+
+    /// Level-0 grid steps along each axis of a level-`level` chunk: `n_t 2^level`.
+    pub fn chunk_span(&self, level: u8) -> i64 {
+        i64::from(self.n_t) << level
     }
 
     /// Whether `key` names a chunk of this layout.
@@ -181,6 +196,94 @@ impl Layout {
             && key.i < self.chunks_per_side(key.level)
             && key.j < self.chunks_per_side(key.level)
             && key.k < self.depth_chunks(key.level)
+    }
+
+    /// The chunk of `level` one step beyond `side` of `key`, or `None` past the shell's inner or
+    /// outer boundary (or when `key` is not a chunk of this layout, or `level` too coarse).
+    ///
+    /// Across a face edge this is the chunk of the neighbouring face whose footprint continues
+    /// `key`'s, found by unfolding the face as Algorithm 1 does. When `level` is coarser than
+    /// `key`'s, the answer is the coarser chunk holding that region; when finer, the finer chunk
+    /// at the middle of that region (one of several).
+    pub fn neighbour(&self, key: &ChunkKey, side: ChunkSide, level: u8) -> Option<ChunkKey> {
+        if !self.contains_chunk(key) || level > self.max_level() {
+            return None;
+        }
+        let span = self.chunk_span(key.level);
+        let (i0, j0, k0) = (
+            i64::from(key.i) * span,
+            i64::from(key.j) * span,
+            i64::from(key.k) * span,
+        );
+        // The middle of the neighbouring same-level chunk, in face grid indices (doubled, so
+        // that an odd span stays exact).
+        let (mut ci, mut cj, mut ck) = (2 * i0 + span, 2 * j0 + span, 2 * k0 + span);
+        match side {
+            ChunkSide::UMin => ci -= 2 * span,
+            ChunkSide::UMax => ci += 2 * span,
+            ChunkSide::VMin => cj -= 2 * span,
+            ChunkSide::VMax => cj += 2 * span,
+            ChunkSide::Inner => ck -= 2 * span,
+            ChunkSide::Outer => ck += 2 * span,
+        }
+        if ck < 0 {
+            return None;
+        }
+        let k_index = ck / 2;
+        let target_span = self.chunk_span(level);
+        let k = k_index / target_span;
+        if k >= i64::from(self.depth_chunks(level)) {
+            return None;
+        }
+        let (face, fi, fj) = self.face_index_doubled(key.face, ci, cj)?;
+        let per_side = i64::from(self.chunks_per_side(level));
+        let i = (fi / (2 * target_span)).min(per_side - 1);
+        let j = (fj / (2 * target_span)).min(per_side - 1);
+        Some(ChunkKey {
+            face,
+            level,
+            i: i as u32,
+            j: j as u32,
+            k: k as u32,
+        })
+    }
+
+    /// A point given in doubled face grid indices of `face` (possibly past one of its edges),
+    /// as doubled face grid indices on the face that holds it. `None` past a cube corner.
+    fn face_index_doubled(&self, face: Face, ci: i64, cj: i64) -> Option<(Face, i64, i64)> {
+        let n2 = 2 * self.face_tiles();
+        let out_i = !(0..=n2).contains(&ci);
+        let out_j = !(0..=n2).contains(&cj);
+        if !out_i && !out_j {
+            return Some((face, ci, cj));
+        }
+        if out_i && out_j {
+            return None;
+        }
+        // Unfold as `lattice` does, with doubled indices: the lattice point in quarter steps.
+        let fr = face.frame();
+        let fold = |x: i64| -> Option<(i64, i64)> {
+            if x < -n2 || x > 2 * n2 {
+                None
+            } else if x > n2 {
+                Some((n2, x - n2))
+            } else if x < 0 {
+                Some((-n2, -x))
+            } else {
+                Some((2 * x - n2, 0))
+            }
+        };
+        let (cu, eu) = fold(ci)?;
+        let (cv, ev) = fold(cj)?;
+        let cn = n2 - 2 * (eu + ev);
+        let p = fr.n.as_i64vec3() * cn + fr.u.as_i64vec3() * cu + fr.v.as_i64vec3() * cv;
+        let other = Face::ALL.into_iter().find(|f| f.frame().n.as_i64vec3().dot(p) == n2)?;
+        let ofr = other.frame();
+        Some((
+            other,
+            (ofr.u.as_i64vec3().dot(p) + n2) / 2,
+            (ofr.v.as_i64vec3().dot(p) + n2) / 2,
+        ))
     }
 
     /// All chunks of `level`, in key order (face, then i, j, k).
@@ -359,6 +462,71 @@ mod tests {
             let key = l.voxel_key(Face::ALL[fi], i, j, k).unwrap();
             let p = l.voxel_position(key);
             prop_assert!((p.length() - l.layer_radius(k)).abs() < 1e-9);
+        }
+    }
+}
+
+#[cfg(test)]
+mod level_tests {
+    use super::*;
+
+    #[test]
+    fn levels_cover_depth_past_the_shell() {
+        let l = Layout::new(8, 32, 1744.0, 4.0, 2).unwrap();
+        assert_eq!(l.max_level(), 3);
+        assert_eq!((l.chunks_per_side(3), l.depth_chunks(3)), (1, 1));
+        assert_eq!(l.depth_chunks(1), 1);
+        assert_eq!(l.depth_chunks(0), 2);
+        let odd = Layout::new(8, 5, 100.0, 1.0, 2).unwrap();
+        assert_eq!(odd.max_level(), 0);
+        let twelve = Layout::new(12, 8, 100.0, 1.0, 3).unwrap();
+        assert_eq!(twelve.max_level(), 2);
+        assert_eq!(twelve.depth_chunks(2), 1);
+    }
+
+    #[test]
+    fn parent_and_children_round_trip() {
+        let key = ChunkKey {
+            face: Face::East,
+            level: 2,
+            i: 3,
+            j: 1,
+            k: 0,
+        };
+        for c in key.children().unwrap() {
+            assert_eq!(c.parent(), key);
+        }
+        assert!(ChunkKey::new(Face::Top, 0, 0, 0).children().is_none());
+    }
+
+    /// Neighbours are symmetric: the neighbour's neighbour across some side is the chunk again,
+    /// on every face edge and next to every cube corner.
+    #[test]
+    fn neighbours_are_mutual_across_face_edges() {
+        let l = Layout::new(4, 4, 100.0, 1.0, 4).unwrap();
+        for level in 0..=l.max_level() {
+            for key in l.chunks(level) {
+                for side in ChunkSide::ALL {
+                    let Some(n) = l.neighbour(&key, side, level) else {
+                        assert!(matches!(side, ChunkSide::Inner | ChunkSide::Outer), "{key} {side:?}");
+                        continue;
+                    };
+                    assert_ne!(n, key);
+                    let back = ChunkSide::ALL
+                        .into_iter()
+                        .filter(|s| l.neighbour(&n, *s, level) == Some(key))
+                        .count();
+                    assert_eq!(back, 1, "{key} {side:?} -> {n}");
+                    if n.face != key.face {
+                        assert!(key.face.is_adjacent(n.face));
+                    }
+                }
+                if level < l.max_level() {
+                    let up = l.neighbour(&key, ChunkSide::UMax, level + 1).unwrap();
+                    let same = l.neighbour(&key, ChunkSide::UMax, level).unwrap();
+                    assert_eq!(up, same.parent());
+                }
+            }
         }
     }
 }

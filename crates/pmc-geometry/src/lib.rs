@@ -35,6 +35,6 @@ pub use cube_sphere::{cube_to_sphere, face_uv_to_cube, face_uv_to_sphere, sphere
 pub use face::{Face, FaceAxis, FaceFrame};
 pub use face_conversion::{convert_axis, AxisMap, FaceTransition};
 pub use glam;
-pub use keys::{ChunkKey, EdgeKey, VoxelKey};
+pub use keys::{ChunkKey, ChunkSide, EdgeKey, SideMask, VoxelKey};
 pub use latlon::{LatLon, LatLonError};
 pub use layout::{Layout, LayoutError, MAX_AXIS_TILES, MAX_CHUNK_TILES};
