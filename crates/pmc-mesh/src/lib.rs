@@ -13,8 +13,10 @@ mod mesher;
 pub mod shell;
 pub mod tables;
 pub mod topology;
+pub mod transition;
 
 pub use chunk_mesh::ChunkMesh;
-pub use mesher::{is_solid, Mesher};
+pub use mesher::{is_solid, voxel_gradient, Mesher};
 pub use shell::close_shell;
 pub use topology::{ManifoldReport, WeldedMesh};
+pub use transition::{coarse_voxels, Transition};

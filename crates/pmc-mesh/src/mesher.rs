@@ -47,6 +47,22 @@ impl Mesher {
     /// # Panics
     /// If `densities.len() != grid.sample_count()`.
     pub fn mesh(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
+        self.mesh_with_transitions(grid, densities, &[], out);
+    }
+
+    /// Meshes one chunk as [`Mesher::mesh`] does, and closes the seam on every side in
+    /// `transitions`, across which the neighbour is one level coarser, with transition patches
+    /// (see [`crate::transition`]). With no transitions the result is [`Mesher::mesh`]'s.
+    ///
+    /// # Panics
+    /// If `densities.len() != grid.sample_count()`.
+    pub fn mesh_with_transitions(
+        &mut self,
+        grid: &ChunkGrid,
+        densities: &[f32],
+        transitions: &[crate::transition::Transition],
+        out: &mut ChunkMesh,
+    ) {
         assert_eq!(
             densities.len(),
             grid.sample_count(),
@@ -90,6 +106,7 @@ impl Mesher {
         } else {
             march_plain(&mut ctx, tables);
         }
+        ctx.emit_transitions(transitions);
         finish_normals(out);
     }
 }
@@ -221,11 +238,56 @@ fn has_sign_change(grid: &ChunkGrid, d: &[f32]) -> bool {
     false
 }
 
-struct Ctx<'a> {
-    grid: &'a ChunkGrid,
-    densities: &'a [f32],
+/// The reciprocal basis of the grid's local frame at padded column `col` (not on the padding's
+/// outer ring): what turns central differences along `u`, `v` and depth into a world gradient.
+fn column_basis(g: &ChunkGrid, col: usize) -> [DVec3; 3] {
+    let p = g.padded;
+    let n = g.dirs[col];
+    let eu = g.dirs[col + 1] - g.dirs[col - 1];
+    let ev = g.dirs[col + p] - g.dirs[col - p];
+    let cvn = ev.cross(n);
+    let det = eu.dot(cvn);
+    if det.abs() > 0.0 {
+        [cvn / det, n.cross(eu) / det, eu.cross(ev) / det]
+    } else {
+        [DVec3::ZERO; 3]
+    }
+}
+
+/// The world gradient from central differences `du`, `dv`, `dk` through a column's reciprocal
+/// basis, with `inv_r = 1 / r` and `inv_dr = 1 / (r[c + 1] - r[c - 1])` of the layer.
+#[inline]
+fn gradient_in_frame(basis: &[DVec3; 3], du: f64, dv: f64, dk: f64, inv_r: f64, inv_dr: f64) -> DVec3 {
+    let [ru, rv, rk] = *basis;
+    (ru * du + rv * dv) * inv_r + rk * (dk * inv_dr)
+}
+
+/// The density gradient at padded voxel `(a, b, c)` of `grid` (not on the padding), exactly as
+/// [`Mesher`] computes it for a vertex's normal: central differences over the six axis
+/// neighbours, `density(a, b, c)` giving the (shell-closed) sample of any padded voxel.
+///
+/// Level-of-detail seams use it to give a vertex of a coarser neighbour's grid edge the normal
+/// that neighbour gives it, bit for bit, from only the few samples around it.
+pub fn voxel_gradient(
+    grid: &ChunkGrid,
+    (a, b, c): (usize, usize, usize),
+    density: impl Fn(usize, usize, usize) -> f32,
+) -> DVec3 {
+    let p = grid.padded;
+    let d = |a: usize, b: usize, c: usize| f64::from(density(a, b, c));
+    let du = d(a + 1, b, c) - d(a - 1, b, c);
+    let dv = d(a, b + 1, c) - d(a, b - 1, c);
+    let dk = d(a, b, c + 1) - d(a, b, c - 1);
+    let dr = grid.radii[(c + 1).min(p - 1)] - grid.radii[c.saturating_sub(1)];
+    let (inv_r, inv_dr) = (1.0 / grid.radii[c], 1.0 / dr);
+    gradient_in_frame(&column_basis(grid, b * p + a), du, dv, dk, inv_r, inv_dr)
+}
+
+pub(crate) struct Ctx<'a> {
+    pub(crate) grid: &'a ChunkGrid,
+    pub(crate) densities: &'a [f32],
     mesher: &'a mut Mesher,
-    out: &'a mut ChunkMesh,
+    pub(crate) out: &'a mut ChunkMesh,
 }
 
 impl Ctx<'_> {
@@ -249,8 +311,14 @@ impl Ctx<'_> {
     fn vertex(&mut self, a: usize, b: usize, c: usize, e: u8) -> u32 {
         let (lo, _) = EDGE_CORNERS[e as usize];
         let o = corner_offset(lo);
-        let (va, vb, vc) = (a + o[0], b + o[1], c + o[2]);
         let axis = EDGE_AXIS[e as usize] as usize;
+        self.edge_vertex((a + o[0], b + o[1], c + o[2]), axis)
+    }
+
+    /// The vertex on the grid edge from padded voxel `v` one step along `axis` (created once).
+    #[inline]
+    pub(crate) fn edge_vertex(&mut self, v: (usize, usize, usize), axis: usize) -> u32 {
+        let (va, vb, vc) = v;
         let vi = self.grid.index(va, vb, vc);
         let slot = vi * 3 + axis;
         let gen = self.mesher.generation;
@@ -270,12 +338,27 @@ impl Ctx<'_> {
 
     /// Creates the vertex on the grid edge between two adjacent padded voxels.
     fn make_vertex(&mut self, v: (usize, usize, usize), w: (usize, usize, usize), axis: usize) -> u32 {
+        let gv = self.gradient(v);
+        let gw = self.gradient(w);
+        self.push_vertex(v, w, axis, gv, gw)
+    }
+
+    /// Pushes the vertex on the grid edge between padded voxels `v` and `w` (adjacent along
+    /// `axis` at any multiple of the grid step), with the density gradients at `v` and `w`.
+    pub(crate) fn push_vertex(
+        &mut self,
+        v: (usize, usize, usize),
+        w: (usize, usize, usize),
+        axis: usize,
+        gv: DVec3,
+        gw: DVec3,
+    ) -> u32 {
         let g = self.grid;
         let p = g.padded;
         // Canonical order: along depth the lower layer first; across the surface the column with
         // the smaller lattice point first. Every chunk holding this edge orders it the same way.
         let first_is_v = axis == 2 || g.lattice[v.1 * p + v.0].to_array() < g.lattice[w.1 * p + w.0].to_array();
-        let (f, s) = if first_is_v { (v, w) } else { (w, v) };
+        let (f, s, gf, gs) = if first_is_v { (v, w, gv, gw) } else { (w, v, gw, gv) };
         let df = f64::from(self.densities[g.index(f.0, f.1, f.2)]);
         let ds = f64::from(self.densities[g.index(s.0, s.1, s.2)]);
         // One endpoint is solid (> 0), the other not, so df - ds is never 0; t lies in [0, 1].
@@ -283,8 +366,6 @@ impl Ctx<'_> {
         let pf = g.position(f.0, f.1, f.2);
         let ps = g.position(s.0, s.1, s.2);
         let pos = pf + (ps - pf) * t;
-        let gf = self.gradient(f);
-        let gs = self.gradient(s);
         let grad = gf + (gs - gf) * t;
         // Stored unnormalised; `finish_normals` normalises them all in one pass.
         let rel = pos - g.origin;
@@ -313,26 +394,16 @@ impl Ctx<'_> {
         let p = g.padded;
         let col = b * p + a;
         if self.mesher.col_stamp[col] != gen {
-            let n = g.dirs[col];
-            let eu = g.dirs[col + 1] - g.dirs[col - 1];
-            let ev = g.dirs[col + p] - g.dirs[col - p];
-            let cvn = ev.cross(n);
-            let det = eu.dot(cvn);
-            self.mesher.col_basis[col] = if det.abs() > 0.0 {
-                [cvn / det, n.cross(eu) / det, eu.cross(ev) / det]
-            } else {
-                [DVec3::ZERO; 3]
-            };
+            self.mesher.col_basis[col] = column_basis(g, col);
             self.mesher.col_stamp[col] = gen;
         }
-        let [ru, rv, rk] = self.mesher.col_basis[col];
         let d = |i: usize| f64::from(self.densities[i]);
         let layer = p * p;
         let du = d(vi + 1) - d(vi - 1);
         let dv = d(vi + p) - d(vi - p);
         let dk = d(vi + layer) - d(vi - layer);
         let [inv_r, inv_dr] = self.mesher.inv_radii[c];
-        let grad = (ru * du + rv * dv) * inv_r + rk * (dk * inv_dr);
+        let grad = gradient_in_frame(&self.mesher.col_basis[col], du, dv, dk, inv_r, inv_dr);
         self.mesher.grad_stamp[vi] = gen;
         self.mesher.grad[vi] = grad;
         grad

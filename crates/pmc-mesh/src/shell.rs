@@ -13,6 +13,28 @@ pub const FORCED_SOLID: f32 = 1.0;
 /// Density written into forced-air samples (the outermost layer) when they were not air.
 pub const FORCED_AIR: f32 = -1.0;
 
+/// The shell contract for one sample at depth index `k`: what [`close_shell`] makes of `d`.
+#[inline]
+pub fn close_sample(k: i64, depth_tiles: i64, d: f32) -> f32 {
+    if k <= 0 {
+        if crate::is_solid(d) {
+            d
+        } else {
+            FORCED_SOLID
+        }
+    } else if k >= depth_tiles {
+        if d.is_nan() || d > 0.0 {
+            FORCED_AIR
+        } else {
+            d
+        }
+    } else if d.is_nan() {
+        FORCED_AIR
+    } else {
+        d
+    }
+}
+
 /// Forces samples at depth index `<= 0` solid and `>= depth_tiles` air (see the module docs).
 /// Also replaces NaN samples by air, so a faulty source cannot poison the mesh.
 ///

@@ -5,8 +5,9 @@ use pmc_density::presets::{self, PresetKind, Terrain};
 use pmc_density::Density;
 use pmc_edit::{affected_chunks, paint_at, BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{ChunkGrid, ChunkKey, EdgeKey, Layout};
-use pmc_mesh::{close_shell, ChunkMesh, Mesher};
+use pmc_geometry::{ChunkGrid, ChunkKey, ChunkSide, EdgeKey, Layout, SideMask};
+use pmc_mesh::shell::close_sample;
+use pmc_mesh::{close_shell, coarse_voxels, voxel_gradient, ChunkMesh, Mesher, Transition};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -308,6 +309,147 @@ impl Planet {
         if let Some(edited) = &self.edited {
             edited.apply_edits(&grid.dirs, &grid.radii, out);
         }
+    }
+
+    /// Meshes a chunk of any level of detail into `out`, closing the seam on every side in
+    /// `coarser` (the sides across which the selected neighbour is one level coarser) with
+    /// transition patches ([`pmc_mesh::transition`]). With an empty mask this is
+    /// [`Planet::chunk_mesh_into`]. Sides with no coarser chunk beyond them (the shell's inner
+    /// and outer boundary, or a chunk already at the coarsest level) are ignored, as is the mask
+    /// when `n_t` is odd (such layouts have only level 0).
+    ///
+    /// The patches' coarse vertices get the coarse neighbour's normals bit for bit: the density
+    /// is sampled at the few coarse voxels around the seam (about `3 (n_t / 2 + 3)^2` samples
+    /// per side, not a whole chunk) and differentiated in the neighbour's frame.
+    ///
+    /// # Panics
+    /// If `key` is not a chunk of the layout (check with [`Layout::contains_chunk`]).
+    pub fn chunk_mesh_lod_into(
+        &self,
+        key: ChunkKey,
+        coarser: SideMask,
+        scratch: &mut ChunkScratch,
+        out: &mut ChunkMesh,
+    ) {
+        let grid = ChunkGrid::new(&self.layout, key);
+        if !self.may_hold_surface(&key) {
+            out.clear();
+            out.key = Some(key);
+            out.origin = grid.origin;
+            return;
+        }
+        scratch.densities.resize(grid.sample_count(), 0.0);
+        self.sample(key, &grid, &mut scratch.densities);
+        close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
+        let sides: Vec<(ChunkSide, Vec<DVec3>)> = if self.layout.n_t() % 2 == 0 {
+            coarser
+                .sides()
+                .filter_map(|side| {
+                    let y = self.layout.neighbour(&key, side, key.level.checked_add(1)?)?;
+                    Some((side, self.coarse_gradients(&grid, side, y)))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let transitions: Vec<Transition> = sides
+            .iter()
+            .map(|(side, g)| Transition {
+                side: *side,
+                gradients: g,
+            })
+            .collect();
+        scratch
+            .mesher
+            .mesh_with_transitions(&grid, &scratch.densities, &transitions, out);
+        self.shade(out, None);
+    }
+
+    /// Meshes a chunk of any level with its seams closed toward coarser neighbours (allocating
+    /// fresh buffers); see [`Planet::chunk_mesh_lod_into`].
+    pub fn chunk_mesh_lod(&self, key: ChunkKey, coarser: SideMask) -> ChunkMesh {
+        let mut out = ChunkMesh::default();
+        self.chunk_mesh_lod_into(key, coarser, &mut ChunkScratch::default(), &mut out);
+        out
+    }
+
+    /// The density gradients that coarse chunk `y` computes at the coarse voxels of `side` of
+    /// the chunk of `grid`, in [`coarse_voxels`] order: the samples around each voxel in `y`'s
+    /// grid, shell-closed, differentiated in `y`'s frame ([`voxel_gradient`]).
+    fn coarse_gradients(&self, grid: &ChunkGrid, side: ChunkSide, y: ChunkKey) -> Vec<DVec3> {
+        let gy = ChunkGrid::new(&self.layout, y);
+        let n = self.layout.face_tiles();
+        let fr = y.face.frame();
+        let p = gy.padded;
+        let last = p as i64 - 2;
+        // Each coarse voxel's padded index in y's grid, from its canonical key.
+        let local: Vec<Option<(usize, usize, usize)>> = coarse_voxels(grid, side)
+            .into_iter()
+            .map(|(a, b, c)| {
+                let key = grid.voxel_key(a, b, c);
+                let l = pmc_geometry::glam::IVec3::from_array(key.lattice).as_i64vec3();
+                let i = (fr.u.as_i64vec3().dot(l) + n) / 2;
+                let j = (fr.v.as_i64vec3().dot(l) + n) / 2;
+                let idx = |x: i64, x0: i64| {
+                    let d = x - x0;
+                    (d % gy.stride == 0 && (1..=last).contains(&(d / gy.stride + 1)))
+                        .then(|| (d / gy.stride + 1) as usize)
+                };
+                let on_face = fr.n.as_i64vec3().dot(l) == n;
+                Some((
+                    idx(i, gy.i0).filter(|_| on_face)?,
+                    idx(j, gy.j0)?,
+                    idx(i64::from(key.k), gy.k0)?,
+                ))
+            })
+            .collect();
+        // The columns and layers the gradients read (each voxel's six neighbours).
+        let mut col_slot = vec![u32::MAX; p * p];
+        let mut layer_slot = vec![u32::MAX; p];
+        let (mut cols, mut layers) = (Vec::new(), Vec::new());
+        for (a, b, c) in local.iter().flatten().copied() {
+            for col in [
+                b * p + a,
+                b * p + a - 1,
+                b * p + a + 1,
+                (b - 1) * p + a,
+                (b + 1) * p + a,
+            ] {
+                if col_slot[col] == u32::MAX {
+                    col_slot[col] = cols.len() as u32;
+                    cols.push(col);
+                }
+            }
+            for l in [c - 1, c, c + 1] {
+                if layer_slot[l] == u32::MAX {
+                    layer_slot[l] = layers.len() as u32;
+                    layers.push(l);
+                }
+            }
+        }
+        let dirs: Vec<DVec3> = cols.iter().map(|c| gy.dirs[*c]).collect();
+        let radii: Vec<f64> = layers.iter().map(|l| gy.radii[*l]).collect();
+        let mut values = vec![0.0f32; dirs.len() * radii.len()];
+        self.density.sample_shell(&dirs, &radii, &mut values);
+        let depth = self.layout.depth_tiles();
+        for (r, row) in layers.iter().zip(values.chunks_exact_mut(dirs.len().max(1))) {
+            let k = gy.k0 + (*r as i64 - 1) * gy.stride;
+            for v in row {
+                *v = close_sample(k, depth, *v);
+            }
+        }
+        let ndirs = dirs.len();
+        local
+            .iter()
+            .map(|l| match l {
+                Some(v) => voxel_gradient(&gy, *v, |a, b, c| {
+                    values[layer_slot[c] as usize * ndirs + col_slot[b * p + a] as usize]
+                }),
+                // Not a voxel of y: the layout or the neighbour is inconsistent; a radial normal
+                // keeps the mesh usable (never reached for keys the selection produces).
+                None => DVec3::ZERO,
+            })
+            .collect()
     }
 
     /// Meshes one chunk (allocating fresh buffers).
