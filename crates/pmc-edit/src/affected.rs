@@ -37,7 +37,7 @@
 use crate::brush::BrushOp;
 use crate::region::{angle_between, ConeShell};
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{face_uv_to_sphere, ChunkKey, Face, Layout};
+use pmc_geometry::{face_uv_to_sphere, ChunkKey, ChunkSide, Face, Layout};
 
 /// Upper bound (with a 2% margin) of how much `(u, v) -> face_uv_to_sphere(face, u, v)` stretches
 /// lengths: arc length on the unit sphere per unit of `(u, v)` distance.
@@ -49,6 +49,34 @@ const BLOCK: usize = 6;
 /// one-voxel padding that normals read) may lie within the brush's reach. In key order.
 pub fn affected_chunks(layout: &Layout, op: &BrushOp) -> Vec<ChunkKey> {
     affected_chunks_at(layout, 0, op)
+}
+
+/// The chunks of every level of detail whose level-of-detail meshes `op` can change, in key
+/// order: at each level `L`, the chunks whose own padded samples it reaches
+/// ([`affected_chunks_at`]), plus the level-`L` chunks next to a reached level-`L + 1` chunk,
+/// whose seam patches toward that coarser chunk read its samples around the seam
+/// (`pmc_planet::Planet::chunk_mesh_lod`). A mesh of any chunk not listed, with any side mask, is
+/// unchanged by `op`.
+pub fn affected_chunks_lod(layout: &Layout, op: &BrushOp) -> Vec<ChunkKey> {
+    let mut out: Vec<ChunkKey> = Vec::new();
+    let mut coarser: Vec<ChunkKey> = Vec::new();
+    for level in (0..=layout.max_level()).rev() {
+        let here = affected_chunks_at(layout, level, op);
+        out.extend(&here);
+        // Finer chunks beside a reached coarser one: the children of its same-level neighbours.
+        for y in &coarser {
+            for side in ChunkSide::ALL {
+                let Some(n) = layout.neighbour(y, side, y.level) else {
+                    continue;
+                };
+                out.extend(n.children().into_iter().flatten().filter(|c| layout.contains_chunk(c)));
+            }
+        }
+        coarser = here;
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// [`affected_chunks`] for the chunks of any level of detail (empty for a level the layout does

@@ -315,7 +315,8 @@ impl Planet {
     /// `coarser` (the sides across which the selected neighbour is one level coarser) with
     /// transition patches ([`pmc_mesh::transition`]). With an empty mask this is
     /// [`Planet::chunk_mesh_into`]. Sides with no coarser chunk beyond them (the shell's inner
-    /// and outer boundary, or a chunk already at the coarsest level) are ignored, as is the mask
+    /// and outer boundary, or a chunk already at the coarsest level) or whose neighbour is a sibling
+    /// are ignored, as is the mask
     /// when `n_t` is odd (such layouts have only level 0).
     ///
     /// The patches' coarse vertices get the coarse neighbour's normals bit for bit: the density
@@ -346,7 +347,9 @@ impl Planet {
                 .sides()
                 .filter_map(|side| {
                     let y = self.layout.neighbour(&key, side, key.level.checked_add(1)?)?;
-                    Some((side, self.coarse_gradients(&grid, side, y)))
+                    // Across a side shared with a sibling the region is the chunk's own parent,
+                    // never a coarser leaf: nothing to close.
+                    (y != key.parent()).then(|| (side, self.coarse_gradients(&grid, side, y)))
                 })
                 .collect()
         } else {

@@ -245,3 +245,46 @@ fn random_splits_close_once_edge_checkerboards_are_refined() {
     }
     assert!(refined > 0, "the rounds should meet some checkerboards");
 }
+
+/// An edit changes the level-of-detail mesh (any level, any side mask) of no chunk outside
+/// `affected_chunks_lod`; some of those changes are seam patches of a finer chunk next to a
+/// reached coarser one, which the per-level lists alone would miss; and edits show at every
+/// level.
+#[test]
+fn edits_change_only_the_listed_chunks_of_every_level() {
+    use pmc_planet::pmc_edit::{affected_chunks_at, affected_chunks_lod, BrushKind, BrushOp};
+    let planet = small_planet(PresetKind::Earthlike, 5);
+    let layout = *planet.layout();
+    let surface = planet.datum_radius();
+    let (mut seam_only, mut changed_levels) = (0, BTreeSet::new());
+    for step in 0..16 {
+        // Small brushes along a line across chunk borders of every level.
+        let u = -0.3 + 0.6 * f64::from(step) / 15.0;
+        let dir = pmc_geometry::face_uv_to_sphere(Face::Top, u, 0.013);
+        let op = BrushOp::new(BrushKind::Remove, dir * surface, 3.0, 1.0).unwrap();
+        let edited = planet.clone().with_edits(vec![op].into());
+        let listed: BTreeSet<ChunkKey> = affected_chunks_lod(&layout, &op).into_iter().collect();
+        let per_level: BTreeSet<ChunkKey> = (0..=layout.max_level())
+            .flat_map(|l| affected_chunks_at(&layout, l, &op))
+            .collect();
+        for level in 0..=layout.max_level() {
+            for key in layout.chunks(level) {
+                for mask in [SideMask::NONE, SideMask::ALL] {
+                    if planet.chunk_mesh_lod(key, mask) != edited.chunk_mesh_lod(key, mask) {
+                        assert!(listed.contains(&key), "{key} (mask {mask:?}) changed but is not listed");
+                        changed_levels.insert(level);
+                        if !per_level.contains(&key) {
+                            seam_only += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(
+        changed_levels.len(),
+        usize::from(layout.max_level()) + 1,
+        "{changed_levels:?}"
+    );
+    assert!(seam_only > 0, "no brush reached a coarser chunk's seam samples only");
+}
