@@ -433,7 +433,27 @@ impl Planet {
         let dirs: Vec<DVec3> = cols.iter().map(|c| gy.dirs[*c]).collect();
         let radii: Vec<f64> = layers.iter().map(|l| gy.radii[*l]).collect();
         let mut values = vec![0.0f32; dirs.len() * radii.len()];
-        self.density.sample_shell(&dirs, &radii, &mut values);
+        // The base values: from y's cached base batch when the planet has one (y is usually a
+        // selected chunk meshed already), else sampled; then the edits, as `sample` does.
+        let cached = self
+            .base_cache
+            .as_ref()
+            .and_then(|c| c.get(&y))
+            .filter(|b| b.len() == gy.sample_count());
+        match cached {
+            Some(base) => {
+                let ndirs = dirs.len();
+                for (li, l) in layers.iter().enumerate() {
+                    for (ci, col) in cols.iter().enumerate() {
+                        values[li * ndirs + ci] = base[l * p * p + col];
+                    }
+                }
+            }
+            None => self.terrain.density.sample_shell(&dirs, &radii, &mut values),
+        }
+        if let Some(edited) = &self.edited {
+            edited.apply_edits(&dirs, &radii, &mut values);
+        }
         let depth = self.layout.depth_tiles();
         for (r, row) in layers.iter().zip(values.chunks_exact_mut(dirs.len().max(1))) {
             let k = gy.k0 + (*r as i64 - 1) * gy.stride;

@@ -288,3 +288,30 @@ fn edits_change_only_the_listed_chunks_of_every_level() {
     );
     assert!(seam_only > 0, "no brush reached a coarser chunk's seam samples only");
 }
+
+/// Seam patches read a coarser neighbour's samples from the base cache when it holds them: the
+/// meshes are byte-identical to uncached ones, with and without edits.
+#[test]
+fn seams_through_the_base_cache_are_byte_identical() {
+    use pmc_planet::pmc_edit::{BrushKind, BrushOp};
+    let plain = small_planet(PresetKind::Earthlike, 7);
+    let layout = *plain.layout();
+    let mut leaves: BTreeSet<ChunkKey> = layout.chunks(1).into_iter().collect();
+    let key = *leaves.iter().find(|k| plain.may_hold_surface(k)).unwrap();
+    split(&layout, &mut leaves, key);
+    let dir = pmc_geometry::face_uv_to_sphere(key.face, 0.0, 0.0);
+    let dig = BrushOp::new(BrushKind::Remove, dir * plain.datum_radius(), 20.0, 1.0).unwrap();
+    for edits in [vec![], vec![dig]] {
+        let plain = plain.clone().with_edits(edits.clone().into());
+        let cached = plain.clone().with_base_cache(4096);
+        let expected = mesh_all(&plain, &leaves);
+        // Coarse chunks first, so their batches are cached when their finer neighbours mesh.
+        let mut order: Vec<ChunkKey> = leaves.iter().copied().collect();
+        order.sort_by_key(|k| std::cmp::Reverse(k.level));
+        for k in order {
+            cached.chunk_mesh_lod(k, SideMask::NONE);
+        }
+        assert_eq!(mesh_all(&cached, &leaves), expected);
+        assert!(cached.base_cache_stats().unwrap().hits > 0);
+    }
+}
