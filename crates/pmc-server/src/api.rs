@@ -1,6 +1,5 @@
 //! The `/api/v1` endpoints (`docs/specs/http-api-v1.md`).
 
-use crate::bounds::{chunks_near, TooManyChunks};
 use crate::generator::{ChunkError, ChunkId, PlanetId};
 use crate::AppState;
 use axum::extract::rejection::PathRejection;
@@ -11,6 +10,7 @@ use axum::Json;
 use pmc_density::Density;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Face};
+use pmc_lod::bounds::{chunks_near, TooManyChunks};
 use pmc_planet::PresetKind;
 use serde_json::{json, Value};
 
@@ -132,6 +132,20 @@ impl Params {
                 Ok(n) if (1..=max).contains(&n) => Ok(n),
                 _ => Err(ApiError::bad_request(format!(
                     "limit must be an integer from 1 to {max}, got '{s}'"
+                ))),
+            },
+        }
+    }
+
+    /// The optional `priority` of a chunk request: a finite number (queued jobs of higher
+    /// priority are generated first), 0 when absent.
+    pub(crate) fn priority(&self) -> Result<f64, ApiError> {
+        match self.get("priority") {
+            None => Ok(0.0),
+            Some(raw) => match raw.trim().parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                _ => Err(ApiError::bad_request(format!(
+                    "query parameter 'priority' must be a finite number (higher is generated first), got '{raw}'"
                 ))),
             },
         }
@@ -281,7 +295,10 @@ fn index_part(name: &str, s: &str) -> Result<u64, ApiError> {
 /// The five parts of a chunk path, as text: face, level, i, j, k.
 type ChunkPath = (String, String, String, String, String);
 
-/// `GET /api/v1/chunk/{face}/{level}/{i}/{j}/{k}`.
+/// `GET /api/v1/chunk/{face}/{level}/{i}/{j}/{k}?priority=`.
+///
+/// A client that hangs up before the answer withdraws its request: the chunk's job, when no
+/// other request waits for it and no worker has started it, is dropped without being generated.
 pub async fn chunk(
     State(state): State<AppState>,
     RawQuery(q): RawQuery,
@@ -290,6 +307,7 @@ pub async fn chunk(
     let Path((face, level, i, j, k)) = path.map_err(|e| ApiError::bad_request(format!("malformed chunk path: {e}")))?;
     let params = Params::parse(q);
     let id = params.planet(&state)?;
+    let priority = params.priority()?;
     let face: Face = face.parse().map_err(ApiError::bad_request)?;
     let (level, i, j, k) = (
         index_part("level", &level)?,
@@ -318,7 +336,7 @@ pub async fn chunk(
     if !layout.contains_chunk(&key) {
         return Err(ApiError::not_found(format!("chunk {shown} is not part of this planet")));
     }
-    match state.chunk(ChunkId { planet: id, key }).await {
+    match state.chunk(ChunkId { planet: id, key }, priority).await {
         Ok(bytes) => {
             let mut r = bytes.into_response();
             let h = r.headers_mut();

@@ -1,5 +1,11 @@
-//! Chunk generation off the async runtime: a worker pool, a bounded queue, in-flight
-//! de-duplication and a cache of encoded chunks bounded by bytes.
+//! Chunk generation off the async runtime: a worker pool, a bounded priority queue, in-flight
+//! de-duplication, cancellation of jobs nobody waits for any more, and a cache of encoded chunks
+//! bounded by bytes.
+//!
+//! Every job counts the requests waiting for it. Each waiting request holds a [`Waiter`]; when
+//! the last one goes away (the client hung up, the request future was dropped) while the job
+//! still waits for a worker, the job leaves the queue at once and is never meshed. A job that a
+//! worker has started runs to the end and is cached.
 
 use crate::lru::ByteLru;
 use axum::body::Bytes;
@@ -8,15 +14,16 @@ use pmc_geometry::ChunkKey;
 use pmc_mesh::ChunkMesh;
 use pmc_planet::{ChunkScratch, Planet, PresetKind};
 use std::cell::RefCell;
-use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::cmp::Ordering;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use tokio::sync::watch;
 
 /// A planet's identity: preset and seed (the layout is the server's).
 pub(crate) type PlanetId = (PresetKind, u64);
 
-/// A chunk of a planet.
+/// A chunk of a planet. The key carries the level of detail, so the chunks of every level are
+/// distinct entries of the cache and distinct jobs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct ChunkId {
     pub planet: PlanetId,
@@ -37,35 +44,123 @@ pub(crate) enum ChunkError {
     Failed(Arc<str>),
 }
 
-/// Counters for `/api/v1/stats`.
-#[derive(Debug, Default)]
-pub(crate) struct Counters {
-    /// Chunks generated (each generation counted once, however many requests waited for it).
-    pub generated: AtomicU64,
+/// A snapshot of the generator's counters (for `/api/v1/stats`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct JobCounts {
     /// Jobs waiting for a worker.
-    pub queued: AtomicUsize,
-    /// Jobs being generated.
-    pub in_flight: AtomicUsize,
-    /// Requests answered 503 because the queue was full.
-    pub rejected_busy: AtomicU64,
+    pub queued: usize,
+    /// Jobs a worker is generating.
+    pub running: usize,
+    /// Requests waiting for a queued or running job.
+    pub waiting: usize,
+    /// Jobs a worker ran to the end (whether they succeeded or not).
+    pub done: u64,
+    /// Jobs that ran to the end and produced a chunk.
+    pub generated: u64,
+    /// Jobs dropped from the queue, never meshed, because every request waiting for them went
+    /// away.
+    pub dropped: u64,
+    /// Requests refused because the queue was full.
+    pub rejected_busy: u64,
 }
 
-/// A job registered for a chunk: its token (to tell it from a later job for the same chunk) and
-/// the receiver its waiters share.
-struct Pending {
-    token: u64,
+/// A job's place in the queue: higher priority first, then older first.
+#[derive(Clone, Copy, Debug)]
+struct Rank {
+    /// Finite, never -0 (so that equal priorities compare equal under `total_cmp`).
+    priority: f64,
+    /// The job's token: tokens grow with each job, so a lower one is an older job.
+    seq: u64,
+}
+
+impl Ord for Rank {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.priority.total_cmp(&self.priority).then(self.seq.cmp(&other.seq))
+    }
+}
+
+impl PartialOrd for Rank {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Rank {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Rank {}
+
+/// Where a job stands.
+enum JobState {
+    /// Waiting in the queue at `rank`, with what the worker needs.
+    Queued {
+        rank: Rank,
+        planet: Arc<Planet>,
+        tx: watch::Sender<Option<JobResult>>,
+    },
+    /// A worker is generating it.
+    Running,
+}
+
+/// A job: queued or running (a job leaves [`Store::jobs`] when it ends or is dropped).
+struct Job {
+    id: ChunkId,
+    /// The receiver its waiters share.
     rx: watch::Receiver<Option<JobResult>>,
+    /// Requests waiting for it (each holds a [`Waiter`]).
+    waiters: usize,
+    state: JobState,
 }
 
 struct Store {
     cache: ByteLru<ChunkId, Bytes>,
-    pending: HashMap<ChunkId, Pending>,
+    /// Jobs queued or running, by token.
+    jobs: HashMap<u64, Job>,
+    /// For each chunk, the token of the job new requests for it join. A job an edit invalidated
+    /// is not here any more: it still answers its waiters, but its result is not cached.
+    pending: HashMap<ChunkId, u64>,
+    /// The queued jobs' tokens, best first.
+    queue: BTreeMap<Rank, u64>,
     /// For each chunk an edit changed: the planet revision of that edit. A planet of a lower
     /// revision must not start a job for the chunk (its mesh would be stale).
     changed_at: HashMap<ChunkId, u64>,
     /// For each planet a change may have touched everywhere: the planet revision of that change.
     min_revision: HashMap<PlanetId, u64>,
     next_token: u64,
+    /// The counters (`queued` and `waiting` are counted when a snapshot is taken).
+    counts: JobCounts,
+}
+
+impl Store {
+    /// Removes job `token` from the chunk's pending entry when it is the one registered there.
+    fn unregister(&mut self, id: ChunkId, token: u64) {
+        if self.pending.get(&id) == Some(&token) {
+            self.pending.remove(&id);
+        }
+    }
+
+    /// Adds a waiter to job `token` (registered in `pending`), raising its priority to
+    /// `priority` when it is still queued at a lower one; returns the receiver of its result.
+    fn join(&mut self, token: u64, priority: f64) -> watch::Receiver<Option<JobResult>> {
+        let Store { jobs, queue, .. } = self;
+        let Some(job) = jobs.get_mut(&token) else {
+            // `pending` only names jobs that exist; a receiver that never gets a value makes the
+            // request fail instead of hanging, should that ever not hold.
+            return watch::channel(None).1;
+        };
+        job.waiters += 1;
+        if let JobState::Queued { rank, .. } = &mut job.state {
+            if priority > rank.priority {
+                queue.remove(&*rank);
+                rank.priority = priority;
+                queue.insert(*rank, token);
+            }
+        }
+        job.rx.clone()
+    }
 }
 
 /// Generates, de-duplicates and caches encoded chunks.
@@ -73,8 +168,19 @@ pub(crate) struct Generator {
     store: Mutex<Store>,
     pool: rayon::ThreadPool,
     queue_limit: usize,
-    /// The counters.
-    pub counters: Counters,
+}
+
+/// A request's hold on a job: dropping it (when the request ends, answered or abandoned) tells
+/// the generator that one waiter fewer wants the job.
+struct Waiter<'a> {
+    generator: &'a Generator,
+    token: u64,
+}
+
+impl Drop for Waiter<'_> {
+    fn drop(&mut self) {
+        self.generator.leave(self.token);
+    }
 }
 
 thread_local! {
@@ -102,14 +208,16 @@ impl Generator {
         Ok(Generator {
             store: Mutex::new(Store {
                 cache: ByteLru::new(cache_bytes),
+                jobs: HashMap::new(),
                 pending: HashMap::new(),
+                queue: BTreeMap::new(),
                 changed_at: HashMap::new(),
                 min_revision: HashMap::new(),
                 next_token: 0,
+                counts: JobCounts::default(),
             }),
             pool,
             queue_limit,
-            counters: Counters::default(),
         })
     }
 
@@ -118,39 +226,69 @@ impl Generator {
     }
 
     /// The encoded chunk `id` of `planet`, whose edits are those of `revision` (0 for a planet
-    /// that is never edited): from the cache, from a job already running for it, or from a new
-    /// job (refused with [`ChunkError::Busy`] when the queue is full, and with
+    /// that is never edited): from the cache, from a job already queued or running for it, or
+    /// from a new job (refused with [`ChunkError::Busy`] when the queue is full, and with
     /// [`ChunkError::Stale`] when an edit of a later revision changed the chunk: the caller
     /// takes the current planet and asks again). `id.key` must be a chunk of the planet's layout.
-    pub async fn chunk(self: &Arc<Self>, planet: Arc<Planet>, revision: u64, id: ChunkId) -> Result<Bytes, ChunkError> {
-        let mut rx = {
+    ///
+    /// Queued jobs are served highest `priority` first (a finite number; a request joining a
+    /// queued job raises the job to its priority), equal priorities oldest first. Dropping the
+    /// returned future before it completes withdraws the request: a queued job that no request
+    /// waits for any more is dropped without being meshed.
+    pub async fn chunk(
+        self: &Arc<Self>,
+        planet: Arc<Planet>,
+        revision: u64,
+        id: ChunkId,
+        priority: f64,
+    ) -> Result<Bytes, ChunkError> {
+        // -0 and +0 are one priority.
+        let priority = priority + 0.0;
+        let (mut rx, token) = {
             let mut store = self.store();
             if let Some(bytes) = store.cache.get(&id) {
                 return Ok(bytes.clone());
             }
-            match store.pending.get(&id) {
-                Some(p) => p.rx.clone(),
+            match store.pending.get(&id).copied() {
+                Some(token) => {
+                    let rx = store.join(token, priority);
+                    (rx, token)
+                }
                 None => {
                     let changed = store.changed_at.get(&id).copied().unwrap_or(0);
                     let everywhere = store.min_revision.get(&id.planet).copied().unwrap_or(0);
                     if changed.max(everywhere) > revision {
                         return Err(ChunkError::Stale);
                     }
-                    if self.counters.queued.load(Ordering::SeqCst) >= self.queue_limit {
-                        self.counters.rejected_busy.fetch_add(1, Ordering::Relaxed);
+                    if store.queue.len() >= self.queue_limit {
+                        store.counts.rejected_busy += 1;
                         return Err(ChunkError::Busy);
                     }
                     let (tx, rx) = watch::channel(None);
                     let token = store.next_token;
                     store.next_token += 1;
-                    store.pending.insert(id, Pending { token, rx: rx.clone() });
-                    self.counters.queued.fetch_add(1, Ordering::SeqCst);
+                    let rank = Rank { priority, seq: token };
+                    store.queue.insert(rank, token);
+                    store.jobs.insert(
+                        token,
+                        Job {
+                            id,
+                            rx: rx.clone(),
+                            waiters: 1,
+                            state: JobState::Queued { rank, planet, tx },
+                        },
+                    );
+                    store.pending.insert(id, token);
+                    // One worker task per queued job: each takes the best job queued when it
+                    // starts, or nothing when dropped jobs left the queue shorter.
                     let this = Arc::clone(self);
-                    self.pool.spawn(move || this.run_job(&planet, id, token, tx));
-                    rx
+                    self.pool.spawn(move || this.work());
+                    (rx, token)
                 }
             }
         };
+        // From here on, dropping this future (the request went away) lets go of the job.
+        let _waiter = Waiter { generator: self, token };
         let result = match rx.wait_for(Option::is_some).await {
             Ok(r) => r.clone(),
             Err(_) => None,
@@ -162,10 +300,33 @@ impl Generator {
         }
     }
 
+    /// One waiter of job `token` went away (answered or not): when it was the last and the job
+    /// is still queued, the job is dropped.
+    fn leave(&self, token: u64) {
+        let mut store = self.store();
+        let Some(job) = store.jobs.get_mut(&token) else {
+            // The job ended: nothing to do.
+            return;
+        };
+        job.waiters = job.waiters.saturating_sub(1);
+        if job.waiters > 0 {
+            return;
+        }
+        let rank = match &job.state {
+            JobState::Queued { rank, .. } => *rank,
+            JobState::Running => return,
+        };
+        let id = job.id;
+        store.queue.remove(&rank);
+        store.jobs.remove(&token);
+        store.unregister(id, token);
+        store.counts.dropped += 1;
+    }
+
     /// Forgets what an edit of `revision` changed: the cached meshes of `ids` and the jobs
-    /// running for them (their waiters still get their answer, but it is not cached), and makes
-    /// planets older than `revision` unable to start jobs for them. Call it after the edited
-    /// planet replaced the old one, before telling clients.
+    /// queued or running for them (their waiters still get their answer, but it is not cached),
+    /// and makes planets older than `revision` unable to start jobs for them. Call it after the
+    /// edited planet replaced the old one, before telling clients.
     pub fn invalidate(&self, ids: impl IntoIterator<Item = ChunkId>, revision: u64) {
         let mut store = self.store();
         for id in ids {
@@ -176,31 +337,46 @@ impl Generator {
         }
     }
 
-    /// Runs one job on a worker: generate, cache, wake the waiters.
-    fn run_job(&self, planet: &Planet, id: ChunkId, token: u64, tx: watch::Sender<Option<JobResult>>) {
-        self.counters.queued.fetch_sub(1, Ordering::SeqCst);
-        self.counters.in_flight.fetch_add(1, Ordering::SeqCst);
+    /// One worker task: takes the best queued job, if any is left, and runs it: generate, cache,
+    /// wake the waiters.
+    fn work(&self) {
+        let (token, id, planet, tx) = {
+            let mut store = self.store();
+            let Some((_, token)) = store.queue.pop_first() else {
+                return;
+            };
+            let Some(job) = store.jobs.get_mut(&token) else {
+                return;
+            };
+            let (planet, tx) = match std::mem::replace(&mut job.state, JobState::Running) {
+                JobState::Queued { planet, tx, .. } => (planet, tx),
+                JobState::Running => return,
+            };
+            let id = job.id;
+            store.counts.running += 1;
+            (token, id, planet, tx)
+        };
         let result: JobResult =
-            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| generate(planet, id.key))) {
+            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| generate(&planet, id.key))) {
                 Ok(Ok(bytes)) => Ok(bytes),
                 Ok(Err(e)) => Err(format!("chunk {} could not be encoded: {e}", id.key).into()),
                 Err(_) => Err(format!("generating chunk {} panicked; this is a bug in pmc", id.key).into()),
             };
-        self.counters.in_flight.fetch_sub(1, Ordering::SeqCst);
-        if result.is_ok() {
-            self.counters.generated.fetch_add(1, Ordering::Relaxed);
-        }
         {
             // Cache and un-register under one lock, so a new request sees one or the other; a
             // job that an edit invalidated meanwhile (it is no longer the registered one) is not
             // cached.
             let mut store = self.store();
-            if store.pending.get(&id).is_some_and(|p| p.token == token) {
-                if let Ok(bytes) = &result {
+            store.counts.running = store.counts.running.saturating_sub(1);
+            store.counts.done += 1;
+            if let Ok(bytes) = &result {
+                store.counts.generated += 1;
+                if store.pending.get(&id) == Some(&token) {
                     store.cache.insert(id, bytes.clone(), bytes.len() as u64);
                 }
-                store.pending.remove(&id);
             }
+            store.unregister(id, token);
+            store.jobs.remove(&token);
         }
         tx.send_replace(Some(result));
     }
@@ -210,8 +386,8 @@ impl Generator {
         self.store().cache.retain(|id| id.planet != planet);
     }
 
-    /// Forgets every cached chunk and running job of `planet` and makes planets older than
-    /// `revision` unable to start jobs for it (after a change that may touch any chunk).
+    /// Forgets every cached chunk and queued or running job of `planet` and makes planets older
+    /// than `revision` unable to start jobs for it (after a change that may touch any chunk).
     pub fn invalidate_planet(&self, planet: PlanetId, revision: u64) {
         let mut store = self.store();
         store.cache.retain(|id| id.planet != planet);
@@ -224,5 +400,35 @@ impl Generator {
     pub fn cache_usage(&self) -> (usize, u64) {
         let store = self.store();
         (store.cache.len(), store.cache.bytes())
+    }
+
+    /// The job counters now.
+    pub fn job_counts(&self) -> JobCounts {
+        let store = self.store();
+        JobCounts {
+            queued: store.queue.len(),
+            waiting: store.jobs.values().map(|j| j.waiters).sum(),
+            ..store.counts
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn higher_priority_ranks_first_then_older() {
+        let r = |priority: f64, seq: u64| Rank { priority, seq };
+        let mut q = BTreeMap::new();
+        for (i, rank) in [r(0.0, 0), r(5.0, 1), r(-1.0, 2), r(5.0, 3), r(0.0, 4), r(1e300, 5)]
+            .into_iter()
+            .enumerate()
+        {
+            q.insert(rank, i);
+        }
+        let order: Vec<usize> = q.into_values().collect();
+        assert_eq!(order, [5, 1, 3, 0, 4, 2]);
+        assert_eq!(r(0.0, 7), r(-0.0 + 0.0, 7));
     }
 }

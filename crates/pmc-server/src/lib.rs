@@ -11,7 +11,7 @@
 //! - Requests may name any preset and seed; the [`ServerConfig::max_planets`] most recently used
 //!   planets are kept, each with its cached chunks.
 //! - `/chunks` finds the chunks near a point with a quadtree per face over provable bounding
-//!   spheres (see [`bounds`]), so it stays fast on planets of any size.
+//!   spheres (see [`pmc_lod::bounds`]), so it stays fast on planets of any size.
 //! - Every malformed request gets a 4xx with a JSON `{"error": ...}`; no request can panic the
 //!   server.
 //!
@@ -26,7 +26,6 @@
 
 pub mod api;
 pub mod assets;
-pub mod bounds;
 mod config;
 pub mod edit_api;
 mod editing;

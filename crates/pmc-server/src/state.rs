@@ -7,7 +7,6 @@ use crate::{ServerConfig, ServerError};
 use axum::body::Bytes;
 use pmc_nav::{Agent, NavGrid};
 use pmc_planet::Planet;
-use std::sync::atomic::Ordering;
 use std::sync::{Arc, PoisonError};
 
 /// The server's state: its settings, the planets it holds, the chunk generator and cache. Cheap
@@ -54,12 +53,31 @@ pub struct Stats {
     pub cached_bytes: u64,
     /// Chunks generated since start (once per generation, however many requests shared it).
     pub generated: u64,
-    /// Chunk jobs waiting for a worker.
+    /// Chunk jobs waiting for a worker (the same as `jobs.queued`).
     pub queued: usize,
-    /// Chunk jobs being generated.
+    /// Chunk jobs being generated (the same as `jobs.running`).
     pub in_flight: usize,
     /// Chunk requests answered 503 because the queue was full.
     pub rejected_busy: u64,
+    /// The chunk jobs.
+    pub jobs: JobStats,
+}
+
+/// The chunk jobs of `/api/v1/stats` (one job per chunk generation, however many requests
+/// share it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct JobStats {
+    /// Jobs waiting for a worker.
+    pub queued: usize,
+    /// Jobs a worker is generating.
+    pub running: usize,
+    /// Requests waiting for a queued or running job (several may share one job).
+    pub waiting: usize,
+    /// Jobs a worker ran to the end since start, failed ones included.
+    pub done: u64,
+    /// Jobs dropped from the queue without being generated since start, because every request
+    /// waiting for them went away (the clients hung up) before a worker took them.
+    pub dropped: u64,
 }
 
 impl std::fmt::Debug for AppState {
@@ -136,14 +154,22 @@ impl AppState {
     pub fn stats(&self) -> Stats {
         let g = &self.inner.generator;
         let (cached_chunks, cached_bytes) = g.cache_usage();
+        let jobs = g.job_counts();
         Stats {
             planets: self.inner.planets.len(),
             cached_chunks,
             cached_bytes,
-            generated: g.counters.generated.load(Ordering::Relaxed),
-            queued: g.counters.queued.load(Ordering::SeqCst),
-            in_flight: g.counters.in_flight.load(Ordering::SeqCst),
-            rejected_busy: g.counters.rejected_busy.load(Ordering::Relaxed),
+            generated: jobs.generated,
+            queued: jobs.queued,
+            in_flight: jobs.running,
+            rejected_busy: jobs.rejected_busy,
+            jobs: JobStats {
+                queued: jobs.queued,
+                running: jobs.running,
+                waiting: jobs.waiting,
+                done: jobs.done,
+                dropped: jobs.dropped,
+            },
         }
     }
 
@@ -182,14 +208,16 @@ impl AppState {
         Ok(planet)
     }
 
-    /// The encoded chunk `id`, meshed from the current version of its planet.
-    pub(crate) async fn chunk(&self, id: ChunkId) -> Result<Bytes, ChunkError> {
+    /// The encoded chunk `id`, meshed from the current version of its planet; queued jobs are
+    /// served highest `priority` (finite) first. Dropping the future withdraws the request (see
+    /// [`Generator::chunk`]).
+    pub(crate) async fn chunk(&self, id: ChunkId, priority: f64) -> Result<Bytes, ChunkError> {
         // An edit between taking the planet and asking the generator makes the planet stale for
         // the chunks it changed; take the new one and ask again (edits are rate-limited, so this
         // ends).
         loop {
             let (planet, revision) = self.planet(id.planet).await.map_err(|e| ChunkError::Failed(e.into()))?;
-            match self.inner.generator.chunk(planet, revision, id).await {
+            match self.inner.generator.chunk(planet, revision, id, priority).await {
                 Err(ChunkError::Stale) => continue,
                 other => return other,
             }

@@ -8,8 +8,8 @@ use common::{app, get, send, small_config, small_layout, stats};
 use pmc_formats::chunk_encoding::{decode_chunk, encode_chunk};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Face, Layout};
+use pmc_lod::bounds::chunk_sphere;
 use pmc_planet::{Planet, PresetKind};
-use pmc_server::bounds::chunk_sphere;
 use pmc_server::ServerConfig;
 use serde_json::Value;
 use std::io::Read;
@@ -312,6 +312,12 @@ async fn malformed_requests_get_a_json_4xx() {
         ("/api/v1/chunk/top/0/0/1.5/0", 400, "chunk j"),
         ("/api/v1/chunk/top/0/0/0/%FF", 400, "malformed"),
         ("/api/v1/chunk/top/0/0/0/0?seed=x", 400, "seed"),
+        (
+            "/api/v1/chunk/top/0/0/0/0?priority=NaN",
+            400,
+            "'priority' must be a finite number",
+        ),
+        ("/api/v1/chunk/top/0/0/0/0?priority=", 400, "priority"),
         ("/api/v1/chunk/top/0/2/0/0", 404, "not part of this planet"),
         ("/api/v1/chunk/top/0/0/0/2", 404, "k below 2"),
         ("/api/v1/chunk/top/1/1/0/0", 404, "not part of this planet"),
@@ -448,6 +454,9 @@ async fn stats_has_every_field() {
         "rejected_busy",
     ] {
         assert!(s[f].is_u64(), "{f} in {s}");
+    }
+    for f in ["queued", "running", "waiting", "done", "dropped"] {
+        assert_eq!(s["jobs"][f], 0, "jobs.{f} in {s}");
     }
     assert_eq!(s["planets"], 0);
 }

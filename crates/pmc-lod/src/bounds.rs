@@ -67,7 +67,7 @@ struct Cap {
 }
 
 /// The angle between two unit vectors, accurate for small angles.
-fn angle_between(a: DVec3, b: DVec3) -> f64 {
+pub(crate) fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
@@ -158,7 +158,11 @@ fn max_chunk_radius(layout: &Layout, level: u8) -> f64 {
     // The largest angle a column cap can get: half diagonal plus the sampling margin (one voxel
     // column stride), both stretched by at most LIPSCHITZ.
     let angle = LIPSCHITZ * (std::f64::consts::SQRT_2 * s / n + (1u64 << level) as f64 / n);
-    let r = layout.radius();
+    // The outermost layer any chunk of the level reaches: past the shell's top for coarse levels
+    // whose depth chunks overhang it.
+    let r = layout
+        .radius()
+        .max(layout.layer_radius(i64::from(layout.depth_chunks(level)) * span(layout, level)));
     if angle >= MAX_CAP_ANGLE {
         return 2.0 * r;
     }
@@ -320,6 +324,9 @@ mod tests {
             Layout::new(2, 8, 100.0, 2.0, 2).unwrap(),
             Layout::new(1, 6, 30.0, 3.0, 1).unwrap(),
             Layout::new(4, 4, 60.0, 4.0, 4).unwrap(),
+            // Coarse chunks reach past the shell's top (three level-0 chunks deep, four per
+            // level-2 chunk).
+            Layout::new(4, 4, 60.0, 4.0, 3).unwrap(),
         ]
     }
 
@@ -403,8 +410,10 @@ mod tests {
             dir in [-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0],
             dist in 0.0f64..3.0,
             range in 0.1f64..400.0,
-            level in 0u8..3,
+            level in 0u8..4,
         ) {
+            // Level 3 chunks reach past the shell's top (four level-0 chunks deep, eight per
+            // level-3 chunk).
             let layout = Layout::new(8, 4, 100.0, 2.0, 4).unwrap();
             let planet = Planet::new(PresetKind::Earthlike, 3, layout);
             let level = level.min(layout.max_level());
