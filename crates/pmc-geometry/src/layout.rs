@@ -3,7 +3,7 @@
 
 use crate::cube_sphere::cube_to_sphere;
 use crate::face::Face;
-use crate::keys::{ChunkKey, ChunkSide, VoxelKey};
+use crate::keys::{ChunkKey, ChunkSide, SideMask, VoxelKey};
 use glam::{DVec3, IVec3};
 
 /// Largest number of tiles along a face edge or the depth axis (keeps lattice keys in 32 bits).
@@ -248,6 +248,23 @@ impl Layout {
         })
     }
 
+    /// The sides of `key` across which a coarser chunk can lie in a level-of-detail selection:
+    /// those whose same-level neighbour exists and is not a sibling (a chunk of the same parent),
+    /// none at the coarsest level. A side mask means the same outside these sides as without
+    /// them, so masks are normalised by `mask & seam_sides(key)` (at most 8 variants a chunk).
+    pub fn seam_sides(&self, key: &ChunkKey) -> SideMask {
+        if key.level >= self.max_level() {
+            return SideMask::NONE;
+        }
+        ChunkSide::ALL
+            .into_iter()
+            .filter(|side| {
+                self.neighbour(key, *side, key.level)
+                    .is_some_and(|n| n.parent() != key.parent())
+            })
+            .fold(SideMask::NONE, SideMask::with)
+    }
+
     /// A point given in doubled face grid indices of `face` (possibly past one of its edges),
     /// as doubled face grid indices on the face that holds it. `None` past a cube corner.
     fn face_index_doubled(&self, face: Face, ci: i64, cj: i64) -> Option<(Face, i64, i64)> {
@@ -482,6 +499,32 @@ mod level_tests {
         let twelve = Layout::new(12, 8, 100.0, 1.0, 3).unwrap();
         assert_eq!(twelve.max_level(), 2);
         assert_eq!(twelve.depth_chunks(2), 1);
+    }
+
+    #[test]
+    fn seam_sides_are_the_sides_away_from_siblings() {
+        let l = Layout::new(4, 4, 100.0, 1.0, 4).unwrap();
+        let key = ChunkKey {
+            face: Face::Top,
+            level: 0,
+            i: 1,
+            j: 2,
+            k: 2,
+        };
+        let s = l.seam_sides(&key);
+        assert!(s.contains(ChunkSide::UMax) && s.contains(ChunkSide::VMin) && s.contains(ChunkSide::Inner));
+        assert!(!s.contains(ChunkSide::UMin) && !s.contains(ChunkSide::VMax) && !s.contains(ChunkSide::Outer));
+        // The outermost chunk has no neighbour beyond its outer side.
+        let outer = ChunkKey { k: 3, ..key };
+        assert!(!l.seam_sides(&outer).contains(ChunkSide::Outer));
+        let top = ChunkKey {
+            face: Face::Top,
+            level: 2,
+            i: 0,
+            j: 0,
+            k: 0,
+        };
+        assert_eq!(l.seam_sides(&top), SideMask::NONE);
     }
 
     #[test]

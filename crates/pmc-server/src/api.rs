@@ -9,7 +9,7 @@ use axum::response::{IntoResponse, Response};
 use axum::Json;
 use pmc_density::Density;
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{ChunkKey, Face};
+use pmc_geometry::{ChunkKey, Face, SideMask};
 use pmc_lod::bounds::{chunks_near, TooManyChunks};
 use pmc_planet::PresetKind;
 use serde_json::{json, Value};
@@ -137,6 +137,22 @@ impl Params {
         }
     }
 
+    /// The optional `seams` of a chunk request: the side mask (0 to 63, bit `n` for side
+    /// `ChunkSide::ALL[n]`: u min, u max, v min, v max, inner, outer) of the sides across which
+    /// the selected neighbour is one level coarser; 0 when absent.
+    pub(crate) fn seams(&self) -> Result<u8, ApiError> {
+        match self.get("seams") {
+            None => Ok(0),
+            Some(raw) => match raw.parse::<u8>() {
+                Ok(m) if m < 64 => Ok(m),
+                _ => Err(ApiError::bad_request(format!(
+                    "query parameter 'seams' must be a side mask from 0 to 63 (bits: u min, u max, v min, v max, inner, \
+                     outer), got '{raw}'"
+                ))),
+            },
+        }
+    }
+
     /// The optional `priority` of a chunk request: a finite number (queued jobs of higher
     /// priority are generated first), 0 when absent.
     pub(crate) fn priority(&self) -> Result<f64, ApiError> {
@@ -187,8 +203,15 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
     let params = Params::parse(q);
     let id = params.planet(&state)?;
     let planet = planet_of(&state, id).await?;
+    let errors = state.lod_errors(id, planet.clone()).await;
     let l = planet.layout();
     let t = planet.terrain();
+    let lod = json!({
+        "max_level": l.max_level(),
+        "errors": errors.as_slice(),
+        "occluder_radius": pmc_lod::occluder_radius(&planet),
+        "seam_sides": ["u_min", "u_max", "v_min", "v_max", "inner", "outer"],
+    });
     let faces: Vec<Value> = Face::ALL
         .iter()
         .map(|f| {
@@ -214,6 +237,7 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
         "presets": presets,
         "layout": { "n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c() },
         "radius": l.radius(),
+        "lod": lod,
         "base_radius": l.d_b(),
         "sea_radius": t.sea_radius,
         "surface_bounds": t.density.radial_bounds().map(|(a, b)| [a, b]),
@@ -295,7 +319,7 @@ fn index_part(name: &str, s: &str) -> Result<u64, ApiError> {
 /// The five parts of a chunk path, as text: face, level, i, j, k.
 type ChunkPath = (String, String, String, String, String);
 
-/// `GET /api/v1/chunk/{face}/{level}/{i}/{j}/{k}?priority=`.
+/// `GET /api/v1/chunk/{face}/{level}/{i}/{j}/{k}?seams=&priority=`.
 ///
 /// A client that hangs up before the answer withdraws its request: the chunk's job, when no
 /// other request waits for it and no worker has started it, is dropped without being generated.
@@ -336,7 +360,8 @@ pub async fn chunk(
     if !layout.contains_chunk(&key) {
         return Err(ApiError::not_found(format!("chunk {shown} is not part of this planet")));
     }
-    match state.chunk(ChunkId { planet: id, key }, priority).await {
+    let seams = SideMask(params.seams()? & layout.seam_sides(&key).0);
+    match state.chunk(ChunkId { planet: id, key, seams }, priority).await {
         Ok(bytes) => {
             let mut r = bytes.into_response();
             let h = r.headers_mut();

@@ -9,8 +9,9 @@
 use crate::generator::{ChunkId, Generator, PlanetId};
 use crate::rate::RateLimiter;
 use crate::{EditLimits, ServerError};
-use pmc_edit::{affected_chunks, BrushOp, EditSnapshot};
+use pmc_edit::{affected_chunks_lod, BrushOp, EditSnapshot};
 use pmc_geometry::ChunkKey;
+use pmc_geometry::SideMask;
 use pmc_nav::NavGrid;
 use pmc_planet::{Planet, PresetKind};
 use pmc_world::{Entry, World, WorldError};
@@ -249,7 +250,7 @@ impl Editing {
                 chunks: Vec::new(),
             });
         };
-        let keys = affected_chunks(self.base.layout(), &op);
+        let keys = affected_chunks_lod(self.base.layout(), &op);
         let current = self.publish(&ed, generator, Some(&keys));
         self.follow_with_nav(&current, Some(&op));
         let chunks: Vec<String> = keys.iter().map(crate::api::key_path).collect();
@@ -312,13 +313,21 @@ impl Editing {
         // The new planet is current before the old meshes are forgotten: a job started from
         // here on meshes the edit (see `Generator::invalidate`).
         match keys {
-            Some(keys) => generator.invalidate(
-                keys.iter().map(|key| ChunkId {
-                    planet: self.id,
-                    key: *key,
-                }),
-                current.revision,
-            ),
+            Some(keys) => {
+                let layout = self.base.layout();
+                generator.invalidate(
+                    keys.iter().flat_map(|key| {
+                        // Every seam variant of the chunk: the submasks of its seam sides.
+                        let sides = layout.seam_sides(key).0;
+                        (0..=sides).filter(move |m| m & !sides == 0).map(move |m| ChunkId {
+                            planet: self.id,
+                            key: *key,
+                            seams: SideMask(m),
+                        })
+                    }),
+                    current.revision,
+                )
+            }
             None => generator.invalidate_planet(self.id, current.revision),
         }
         current
@@ -376,7 +385,7 @@ impl Editing {
         }
         let step = one_step(&ed.entries, &entries);
         ed.entries = entries;
-        let keys = step.map(|(_, _, op)| affected_chunks(self.base.layout(), &op));
+        let keys = step.map(|(_, _, op)| affected_chunks_lod(self.base.layout(), &op));
         let current = self.publish(ed, generator, keys.as_deref());
         self.follow_with_nav(&current, step.as_ref().map(|(_, _, op)| op));
         tracing::info!(

@@ -10,7 +10,7 @@
 use crate::lru::ByteLru;
 use axum::body::Bytes;
 use pmc_formats::chunk_encoding::encode_chunk;
-use pmc_geometry::ChunkKey;
+use pmc_geometry::{ChunkKey, SideMask};
 use pmc_mesh::ChunkMesh;
 use pmc_planet::{ChunkScratch, Planet, PresetKind};
 use std::cell::RefCell;
@@ -28,6 +28,9 @@ pub(crate) type PlanetId = (PresetKind, u64);
 pub(crate) struct ChunkId {
     pub planet: PlanetId,
     pub key: ChunkKey,
+    /// The sides whose seams toward a coarser neighbour the mesh closes, normalised to
+    /// [`pmc_geometry::Layout::seam_sides`] (so one chunk has at most 8 variants).
+    pub seams: SideMask,
 }
 
 /// The outcome of one job, shared by every request that waited for it.
@@ -188,9 +191,9 @@ thread_local! {
 }
 
 /// Meshes and encodes one chunk (on a worker thread).
-fn generate(planet: &Planet, key: ChunkKey) -> Result<Bytes, String> {
+fn generate(planet: &Planet, key: ChunkKey, seams: SideMask) -> Result<Bytes, String> {
     let mut mesh = ChunkMesh::default();
-    SCRATCH.with(|s| planet.chunk_mesh_into(key, &mut s.borrow_mut(), &mut mesh));
+    SCRATCH.with(|s| planet.chunk_mesh_lod_into(key, seams, &mut s.borrow_mut(), &mut mesh));
     let mut out = Vec::new();
     encode_chunk(&mesh, &mut out).map_err(|e| e.to_string())?;
     Ok(Bytes::from(out))
@@ -357,7 +360,7 @@ impl Generator {
             (token, id, planet, tx)
         };
         let result: JobResult =
-            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| generate(&planet, id.key))) {
+            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| generate(&planet, id.key, id.seams))) {
                 Ok(Ok(bytes)) => Ok(bytes),
                 Ok(Err(e)) => Err(format!("chunk {} could not be encoded: {e}", id.key).into()),
                 Err(_) => Err(format!("generating chunk {} panicked; this is a bug in pmc", id.key).into()),

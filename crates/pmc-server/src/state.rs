@@ -25,7 +25,12 @@ struct Inner {
     navs: std::sync::Mutex<std::collections::VecDeque<NavEntry>>,
     /// Set when the server begins to stop: long-lived answers (the event streams) end.
     stopping: tokio::sync::watch::Sender<bool>,
+    /// Measured level-of-detail errors (metres per level) by planet, computed once each.
+    lod_errors: std::sync::Mutex<std::collections::HashMap<PlanetId, Arc<Vec<f64>>>>,
 }
+
+/// Points sampled per level when measuring level-of-detail errors.
+const LOD_ERROR_SAMPLES: usize = 2048;
 
 /// Navigation grids kept besides the world's default one.
 const MAX_NAV_GRIDS: usize = 3;
@@ -87,6 +92,33 @@ impl std::fmt::Debug for AppState {
 }
 
 impl AppState {
+    /// The measured geometric error of each level of detail of a planet (metres, index =
+    /// level; `pmc_lod::measure_level_errors` with a fixed seed), computed on first use and
+    /// kept. Runs on a blocking thread.
+    pub(crate) async fn lod_errors(&self, id: PlanetId, planet: Arc<pmc_planet::Planet>) -> Arc<Vec<f64>> {
+        if let Some(e) = self
+            .inner
+            .lod_errors
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .get(&id)
+        {
+            return e.clone();
+        }
+        let measured =
+            tokio::task::spawn_blocking(move || pmc_lod::measure_level_errors(&planet, LOD_ERROR_SAMPLES, 0x5eed))
+                .await
+                .map(Arc::new)
+                .unwrap_or_else(|_| Arc::new(Vec::new()));
+        self.inner
+            .lod_errors
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .entry(id)
+            .or_insert(measured)
+            .clone()
+    }
+
     /// Checks `config`, opens (or creates) its world when it names one, and starts the worker
     /// threads. With a world, [`AppState::config`] holds the world's preset, seed and layout.
     pub fn new(mut config: ServerConfig) -> Result<AppState, ServerError> {
@@ -127,6 +159,7 @@ impl AppState {
                 generator: Arc::new(generator),
                 editing,
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
+                lod_errors: std::sync::Mutex::new(std::collections::HashMap::new()),
                 stopping: tokio::sync::watch::Sender::new(false),
                 config,
             }),

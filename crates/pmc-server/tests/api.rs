@@ -460,3 +460,58 @@ async fn stats_has_every_field() {
     }
     assert_eq!(s["planets"], 0);
 }
+
+/// Level-of-detail chunks: `/planet` describes the levels and their measured errors, and a
+/// chunk asked with `seams` is the planet's mesh with those seams closed (normalised to the
+/// sides where a coarser neighbour can lie); malformed masks are refused.
+#[tokio::test]
+async fn lod_chunks_close_the_seams_they_are_asked_for() {
+    let a = app(small_config());
+    let planet = Planet::new(PresetKind::Earthlike, 3, small_layout());
+    let v = get(&a, "/api/v1/planet").await.json();
+    let lod = &v["lod"];
+    let max_level = planet.layout().max_level();
+    assert_eq!(lod["max_level"], u64::from(max_level));
+    let errors: Vec<f64> = lod["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_f64().unwrap())
+        .collect();
+    assert_eq!(errors.len(), usize::from(max_level) + 1);
+    assert_eq!(errors[0], 0.0);
+    assert!(
+        errors.windows(2).all(|w| w[0] <= w[1] && w[1].is_finite()),
+        "{errors:?}"
+    );
+    assert!(lod["occluder_radius"].as_f64().unwrap() > 0.0);
+
+    let key = planet
+        .layout()
+        .chunks(0)
+        .into_iter()
+        .filter(|k| !planet.layout().seam_sides(k).is_empty())
+        .max_by_key(|k| planet.chunk_mesh(*k).triangle_count())
+        .unwrap();
+    let sides = planet.layout().seam_sides(&key);
+    let path = format!("/api/v1/chunk/{}/0/{}/{}/{}", key.face.name(), key.i, key.j, key.k);
+    let encode = |m: &pmc_mesh::ChunkMesh| {
+        let mut out = Vec::new();
+        encode_chunk(m, &mut out).unwrap();
+        out
+    };
+    let closed = get(&a, &format!("{path}?seams=63")).await;
+    assert_eq!(closed.status, StatusCode::OK);
+    assert_eq!(
+        closed.body.as_ref(),
+        encode(&planet.chunk_mesh_lod(key, sides)).as_slice()
+    );
+    let plain = get(&a, &path).await;
+    assert_eq!(plain.body.as_ref(), encode(&planet.chunk_mesh(key)).as_slice());
+    assert_ne!(plain.body, closed.body, "closing the seams adds patches");
+    for bad in ["64", "-1", "x", "1.5"] {
+        let r = get(&a, &format!("{path}?seams={bad}")).await;
+        assert_eq!(r.status, StatusCode::BAD_REQUEST, "seams={bad}");
+        assert!(String::from_utf8_lossy(&r.body).contains("seams"));
+    }
+}

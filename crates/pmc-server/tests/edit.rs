@@ -8,7 +8,7 @@ use axum::http::{Request, StatusCode};
 use axum::Router;
 use common::{get, send, small_config, small_layout, Reply};
 use futures_util::StreamExt;
-use pmc_edit::{affected_chunks, BrushKind, BrushOp};
+use pmc_edit::{affected_chunks_lod, BrushKind, BrushOp};
 use pmc_formats::chunk_encoding::encode_chunk;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Layout};
@@ -70,6 +70,14 @@ fn surface_top(planet: &Planet) -> DVec3 {
 fn encoded(planet: &Planet, key: ChunkKey) -> Vec<u8> {
     let mut out = Vec::new();
     encode_chunk(&planet.chunk_mesh(key), &mut out).unwrap();
+    out
+}
+
+/// A chunk's encoded level-of-detail mesh with every seam side closed.
+fn encoded_seams(planet: &Planet, key: ChunkKey) -> Vec<u8> {
+    let mut out = Vec::new();
+    let seams = planet.layout().seam_sides(&key);
+    encode_chunk(&planet.chunk_mesh_lod(key, seams), &mut out).unwrap();
     out
 }
 
@@ -149,14 +157,22 @@ async fn edits_change_exactly_the_listed_chunks_and_undo_redo_restore_them() {
     let (_, a) = world_app(&path);
     let base = unedited();
     let op = remove_at(surface_top(&base), 6.0);
-    let keys = affected_chunks(base.layout(), &op);
+    let keys = affected_chunks_lod(base.layout(), &op);
     assert!(!keys.is_empty());
-    // Every chunk fetched (and cached) before the edit.
+    // Every chunk fetched (and cached) before the edit, and every coarser chunk with all its
+    // seams closed.
     let all = base.layout().chunks(0);
+    let coarse: Vec<ChunkKey> = (1..=base.layout().max_level())
+        .flat_map(|l| base.layout().chunks(l))
+        .collect();
     for k in &all {
         let r = get(&a, &chunk_uri(k)).await;
         assert_eq!(r.status, StatusCode::OK);
         assert_eq!(r.body.as_ref(), encoded(&base, *k).as_slice());
+    }
+    for k in &coarse {
+        let r = get(&a, &format!("{}?seams=63", chunk_uri(k))).await;
+        assert_eq!(r.body.as_ref(), encoded_seams(&base, *k).as_slice(), "{k}");
     }
     let r = post(&a, "/api/v1/edits", body_of(&op)).await;
     assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
@@ -181,6 +197,16 @@ async fn edits_change_exactly_the_listed_chunks_and_undo_redo_restore_them() {
         }
     }
     assert!(changed > 0, "the edit changed some chunk");
+    let mut changed_coarse = 0;
+    for k in &coarse {
+        let got = get(&a, &format!("{}?seams=63", chunk_uri(k))).await.body;
+        assert_eq!(got.as_ref(), encoded_seams(&edited, *k).as_slice(), "chunk {k}");
+        if got.as_ref() != encoded_seams(&base, *k).as_slice() {
+            changed_coarse += 1;
+            assert!(keys.contains(k), "chunk {k} changed but was not listed");
+        }
+    }
+    assert!(changed_coarse > 0, "the edit changed some coarser chunk");
 
     // The edit is in the file, durably.
     let w = World::open(&path).unwrap();
@@ -503,7 +529,10 @@ async fn subscribers_are_told_of_every_edit_in_order() {
         (name.as_str(), e["action"].as_str(), e["revision"].as_u64()),
         ("edit", Some("apply"), Some(4))
     );
-    let listed: Vec<String> = affected_chunks(&small_layout(), &op2).iter().map(key_path).collect();
+    let listed: Vec<String> = affected_chunks_lod(&small_layout(), &op2)
+        .iter()
+        .map(key_path)
+        .collect();
     assert_eq!(e["chunks"], json!(listed));
     assert!(!state.sync_world().await.unwrap(), "nothing new");
     // Several steps at once: everything is reloaded.
