@@ -150,14 +150,17 @@ impl WorldPlanetArgs {
     /// The planet of a new world: the given options, the defaults of `pmc generate` elsewhere.
     fn for_new_world(&self) -> Result<(PresetKind, u64, Layout), CliError> {
         let d = DefaultPlanet::parse_from(["pmc"]).planet;
+        let preset = self.preset.unwrap_or(d.preset);
+        // The preset's own layout (the earth's is true scale) where no option was typed.
+        let base = preset.default_layout(None)?;
         let layout = Layout::new(
-            self.n_c.unwrap_or(d.n_c),
-            self.n_t.unwrap_or(d.n_t),
-            self.d_b.unwrap_or(d.d_b),
-            self.l_d.unwrap_or(d.l_d),
-            self.d_c.unwrap_or(d.d_c),
+            self.n_c.unwrap_or(base.n_c()),
+            self.n_t.unwrap_or(base.n_t()),
+            self.d_b.unwrap_or(base.d_b()),
+            self.l_d.unwrap_or(base.l_d()),
+            self.d_c.unwrap_or(base.d_c()),
         )?;
-        Ok((self.preset.unwrap_or(d.preset), self.seed.unwrap_or(d.seed), layout))
+        Ok((preset, self.seed.unwrap_or(d.seed), layout))
     }
 
     /// Refuses options that disagree with the world's planet, naming each.

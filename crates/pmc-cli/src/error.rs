@@ -9,9 +9,12 @@ pub enum CliError {
     /// Invalid layout parameters.
     #[error("invalid planet layout: {0}")]
     Layout(#[from] pmc_geometry::LayoutError),
+    /// A `--radius` no layout can be chosen for.
+    #[error("invalid --radius: {0}")]
+    Radius(#[from] pmc_density::presets::RadiusError),
     /// The planet is too large to mesh whole in memory.
     #[error(
-        "the planet is too large to mesh whole: {face_tiles} tiles per face side and {chunks} chunks (at most {} and {}); lower n_c, n_t or d_c",
+        "the planet is too large to mesh whole: {face_tiles} tiles per face side and {chunks} chunks (at most {} and {}); export a region of it instead (pmc generate --region LAT,LON,RADIUS_M [--level L | --max-error M]), fly over it with pmc serve, or lower n_c, n_t or d_c",
         crate::work::MAX_WHOLE_PLANET_FACE_TILES,
         crate::work::MAX_WHOLE_PLANET_CHUNKS
     )]
@@ -50,6 +53,9 @@ pub enum CliError {
     /// Invalid `pmc edit` options, or planet options that disagree with the world file.
     #[error("{0}")]
     Edit(String),
+    /// An invalid `--region` (or its level or error), or a region too large.
+    #[error("invalid --region: {0}")]
+    Region(String),
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads: {reason}")]
     Threads {
@@ -64,7 +70,12 @@ impl CliError {
     /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Layout(_) | CliError::Output { .. } | CliError::TooLarge { .. } | CliError::Host(_) => 2,
+            CliError::Layout(_)
+            | CliError::Radius(_)
+            | CliError::Output { .. }
+            | CliError::TooLarge { .. }
+            | CliError::Region(_)
+            | CliError::Host(_) => 2,
             CliError::Serve(pmc_server::ServerError::Config(_)) => 2,
             CliError::Serve(_) => 1,
             CliError::Render(pmc_render::RenderError::Io { .. } | pmc_render::RenderError::Png { .. }) => 1,

@@ -6,6 +6,7 @@ use crate::work;
 use clap::Args;
 use indicatif::ProgressBar;
 use pmc_formats::{ExportMeta, Format};
+use pmc_geometry::LatLon;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,8 +23,22 @@ pub struct GenerateArgs {
 
     /// Export the planet of this world file, with its edits (see `pmc edit`). The planet options
     /// then come from the world and cannot be given.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "seed", "n_c", "n_t", "d_b", "l_d", "d_c"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "seed", "radius", "n_c", "n_t", "d_b", "l_d", "d_c"])]
     world: Option<PathBuf>,
+
+    /// Export only a region: the chunks of one level of detail within RADIUS_M metres of the
+    /// surface point at LAT,LON (degrees). For planets too large to mesh whole (Earth). The
+    /// level is --level, or the coarsest whose measured error is within --max-error, or 0.
+    #[arg(long, value_name = "LAT,LON,RADIUS_M", allow_hyphen_values = true)]
+    region: Option<String>,
+
+    /// With --region: the level of detail (0 finest; `pmc info` lists the levels).
+    #[arg(long, value_name = "L", requires = "region", conflicts_with = "max_error")]
+    level: Option<u8>,
+
+    /// With --region: the coarsest level whose measured geometric error is at most M metres.
+    #[arg(long, value_name = "M", requires = "region", allow_negative_numbers = true)]
+    max_error: Option<f64>,
 
     /// Worker threads; 0 uses every core. The output does not depend on it.
     #[arg(long, default_value_t = 0, value_name = "N")]
@@ -32,6 +47,32 @@ pub struct GenerateArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// Most chunks a `--region` export may hold.
+const REGION_BUDGET: usize = 200_000;
+
+/// Parses `--region LAT,LON,RADIUS_M`.
+fn parse_region(s: &str) -> Result<(f64, f64, f64), CliError> {
+    let err = |why: String| CliError::Region(format!("{s}: {why}; give LAT,LON,RADIUS_M (degrees, degrees, metres)"));
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(err(format!("expected 3 numbers, got {}", parts.len())));
+    }
+    let num = |name: &str, t: &str| {
+        t.parse::<f64>()
+            .map_err(|_| err(format!("the {name} {t:?} is not a number")))
+    };
+    let (lat, lon, radius) = (
+        num("latitude", parts[0])?,
+        num("longitude", parts[1])?,
+        num("radius", parts[2])?,
+    );
+    LatLon::new(lat, lon).map_err(|e| err(e.to_string()))?;
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err(err(format!("the radius {radius} is not a number of metres above 0")));
+    }
+    Ok((lat, lon, radius))
 }
 
 /// Checks, before any work, that `path` can be written in a known format.
@@ -50,12 +91,47 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
         None => pmc_planet::Planet::new(args.planet.preset, args.planet.seed, args.planet.layout()?),
     };
     let layout = *planet.layout();
-    work::check_whole_planet(&layout)?;
+    let region = match &args.region {
+        Some(r) => Some(parse_region(r)?),
+        None => {
+            work::check_whole_planet(&layout)?;
+            None
+        }
+    };
     check_output(&args.output)?;
     let pool = work::thread_pool(args.threads)?;
     let start = Instant::now();
-    let total = layout.chunk_count();
-    let meshes = work::mesh_planet(&planet, &pool, args.quiet);
+    let (total, meshes) = match region {
+        Some((lat, lon, radius)) => {
+            let level = match (args.level, args.max_error) {
+                (Some(l), _) => l,
+                (None, Some(e)) if e.is_finite() && e >= 0.0 => {
+                    pmc_lod::level_for_error(&pmc_lod::measure_level_errors(&planet, 2048, 0x5eed), e)
+                }
+                (None, Some(e)) => {
+                    return Err(CliError::Region(format!(
+                        "--max-error must be a finite number of metres, at least 0, got {e}"
+                    )))
+                }
+                (None, None) => 0,
+            };
+            let centre = LatLon::new(lat, lon)
+                .map_err(|e| CliError::Region(e.to_string()))?
+                .to_unit()
+                * planet.datum_radius();
+            let keys = pmc_lod::region_chunks(&planet, centre, radius, level, REGION_BUDGET)
+                .map_err(|e| CliError::Region(e.to_string()))?;
+            if !args.quiet {
+                eprintln!(
+                    "region of {radius} m around {lat}, {lon}: {} chunks of level {level} ({} m tiles along depth)",
+                    keys.len(),
+                    layout.l_d() * f64::from(1u32 << level)
+                );
+            }
+            (keys.len() as u64, work::mesh_chunks(&planet, &keys, &pool, args.quiet))
+        }
+        None => (layout.chunk_count(), work::mesh_planet(&planet, &pool, args.quiet)),
+    };
     let meshed = start.elapsed();
     let t = planet.terrain();
     let meta = ExportMeta {

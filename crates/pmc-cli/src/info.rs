@@ -1,8 +1,10 @@
-//! `pmc info`: the layout's counts and radius (seed 000 Eq. (2)-(4)) and the terrain.
+//! `pmc info`: the layout's counts and radius (seed 000 Eq. (2)-(4)), its levels of detail and
+//! the terrain.
 
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
 use clap::Args;
+use pmc_geometry::{Face, Layout};
 
 /// Options of `pmc info`.
 #[derive(Args, Debug)]
@@ -26,6 +28,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     // Counting chunks one by one is only worth it for planets that can be meshed whole.
     let candidate = (l.chunk_count() <= crate::work::MAX_WHOLE_PLANET_CHUNKS)
         .then(|| l.chunks(0).iter().filter(|k| planet.may_hold_surface(k)).count());
+    let levels: Vec<Level> = (0..=l.max_level()).map(|level| Level::of(l, level)).collect();
     if args.json {
         let v = serde_json::json!({
             "preset": t.kind.name(),
@@ -42,6 +45,17 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             "surface_bounds": bounds.map(|(a, b)| [a, b]),
             "chunks_that_may_hold_surface": candidate,
             "materials": t.materials,
+            "max_level": l.max_level(),
+            "levels": levels.iter().map(|v| serde_json::json!({
+                "level": v.level,
+                "chunks_per_side": v.per_side,
+                "depth_chunks": v.depth,
+                "voxel_across_min": v.across.0,
+                "voxel_across_max": v.across.1,
+                "voxel_radial": v.radial,
+                "chunk_across": v.chunk_across,
+                "chunk_deep": v.chunk_deep,
+            })).collect::<Vec<_>>(),
         });
         println!("{}", serde_json::to_string_pretty(&v).expect("JSON of plain values"));
         return Ok(());
@@ -88,5 +102,93 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         }
     }
     println!("materials    {}", t.materials.join(", "));
+    println!(
+        "levels       {} levels of detail, 0 to {}; voxel widths across the face (min-max) at radius {} m",
+        levels.len(),
+        l.max_level(),
+        l.radius()
+    );
+    println!("  level  chunks/side  depth chunks  voxel across (min-max)  voxel radial  chunk (across x deep)");
+    for v in &levels {
+        println!(
+            "  {:>5}  {:>11}  {:>12}  {:>22}  {:>12}  {:>21}",
+            v.level,
+            v.per_side,
+            v.depth,
+            format!("{} - {}", length(v.across.0), length(v.across.1)),
+            length(v.radial),
+            format!("{} x {}", length(v.chunk_across), length(v.chunk_deep)),
+        );
+    }
     Ok(())
+}
+
+/// One level of detail of a layout.
+struct Level {
+    level: u8,
+    /// Chunks per face side.
+    per_side: u32,
+    /// Chunks along depth.
+    depth: u32,
+    /// Smallest and largest voxel edge across the face at the layout radius (metres), from the
+    /// edges at a grid of 65 x 65 places on a face (every face is the same).
+    across: (f64, f64),
+    /// Voxel depth, `l_d 2^level` metres.
+    radial: f64,
+    /// A chunk's mean width across the face and its depth (metres).
+    chunk_across: f64,
+    chunk_deep: f64,
+}
+
+impl Level {
+    fn of(l: &Layout, level: u8) -> Level {
+        let stride = 1i64 << level;
+        let n = l.face_tiles();
+        let radius = l.radius();
+        // Places on the level's grid: the face's edges, its middle and a regular grid between.
+        let samples = 64.min(n / stride);
+        let place = |t: i64| (t * (n / stride) / samples) * stride;
+        let dir = |i: i64, j: i64| l.lattice(Face::ALL[0], i, j).map(|p| l.lattice_direction(p));
+        let (mut lo, mut hi) = (f64::MAX, 0.0f64);
+        for a in 0..=samples {
+            for b in 0..=samples {
+                let (i, j) = (place(a).min(n - stride), place(b));
+                if let (Some(p), Some(q)) = (dir(i, j), dir(i + stride, j)) {
+                    let w = (q - p).length() * radius;
+                    lo = lo.min(w);
+                    hi = hi.max(w);
+                }
+            }
+        }
+        let span = l.chunk_span(level) as f64;
+        Level {
+            level,
+            per_side: l.chunks_per_side(level),
+            depth: l.depth_chunks(level),
+            across: (lo, hi),
+            radial: l.l_d() * stride as f64,
+            chunk_across: span * std::f64::consts::FRAC_PI_2 * radius / n as f64,
+            chunk_deep: span * l.l_d(),
+        }
+    }
+}
+
+/// A length in metres for people: three significant figures, in km from 10 km.
+fn length(m: f64) -> String {
+    if m >= 10_000.0 {
+        format!("{} km", sig3(m / 1000.0))
+    } else {
+        format!("{} m", sig3(m))
+    }
+}
+
+fn sig3(x: f64) -> String {
+    let decimals = if x >= 100.0 {
+        0
+    } else if x >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{x:.decimals$}")
 }

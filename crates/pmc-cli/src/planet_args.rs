@@ -1,65 +1,218 @@
 //! The options that describe a planet, shared by every command.
+//!
+//! The layout comes from the preset unless options say otherwise: `--radius R` picks the
+//! preset's layout for that radius ([`PresetKind::default_layout`]) and cannot be combined with
+//! the five layout options; without it, each of `--n-c`, `--n-t`, `--d-b`, `--l-d`, `--d-c` that
+//! is typed replaces that parameter of the preset's own layout (the Earth at true scale for
+//! `--preset earth`, the 2000 m default planet for the others).
 
-use clap::Args;
-use pmc_geometry::{Layout, LayoutError};
+use crate::error::CliError;
+use clap::parser::ValueSource;
+use clap::{ArgMatches, Args, Command, FromArgMatches};
+use pmc_geometry::Layout;
 use pmc_planet::{Planet, PresetKind};
 
-/// Preset, seed and the layout parameters of seed 000 Sec. 4.3, under the paper's names.
+/// The ids of the five layout options, in the order of [`Layout::new`]'s parameters.
+const LAYOUT_IDS: [&str; 5] = ["n_c", "n_t", "d_b", "l_d", "d_c"];
+
+/// The planet options as clap parses them.
 #[derive(Args, Debug, Clone)]
-pub struct PlanetArgs {
+struct PlanetOptions {
     /// Terrain preset: sphere (an exact sphere, for checks), earthlike (continents, seas,
-    /// mountains, caves and overhangs), moon (craters, maria, lava tubes) or mars (canyons,
-    /// volcanoes, polar caps, caves).
+    /// mountains, caves and overhangs), moon (craters, maria, lava tubes), mars (canyons,
+    /// volcanoes, polar caps, caves) or earth (the Earth at true scale, 6 371 km with 1 m voxels,
+    /// on its own layout unless layout options are given).
     #[arg(long, default_value = "earthlike", value_parser = parse_preset)]
-    pub preset: PresetKind,
+    preset: PresetKind,
 
     /// Seed for the terrain noise: the same seed and parameters give byte-identical output.
     #[arg(long, default_value_t = 7)]
-    pub seed: u64,
+    seed: u64,
 
-    /// n_c: chunks along each side of a cube face.
-    #[arg(long = "n-c", default_value_t = 8, value_name = "N")]
-    pub n_c: u32,
+    /// Planet radius in metres (100 to 1e8): picks the preset's layout for it, with the middle of
+    /// the shell (the sea of the earth preset) at this radius, voxels of 1 to 2 m and chunks per
+    /// face side a power of two. Cannot be combined with --n-c, --n-t, --d-b, --l-d, --d-c.
+    #[arg(
+        long,
+        value_name = "METRES",
+        allow_negative_numbers = true,
+        conflicts_with_all = LAYOUT_IDS
+    )]
+    radius: Option<f64>,
 
-    /// n_t: tiles (marching cubes) along each side of a chunk, 1..=128.
-    #[arg(long = "n-t", default_value_t = 32, value_name = "N")]
-    pub n_t: u32,
+    /// n_c: chunks along each side of a cube face [preset's layout: 8; earth: 262144].
+    #[arg(long = "n-c", default_value_t = 8, value_name = "N", hide_default_value = true)]
+    n_c: u32,
 
-    /// d_b: base depth, the radius in metres of the innermost voxel layer (at least l_d).
+    /// n_t: tiles (marching cubes) along each side of a chunk, 1..=128 [preset's layout: 32].
+    #[arg(long = "n-t", default_value_t = 32, value_name = "N", hide_default_value = true)]
+    n_t: u32,
+
+    /// d_b: base depth, the radius in metres of the innermost voxel layer (at least l_d)
+    /// [preset's layout: 1744; earth: 6354616].
     #[arg(
         long = "d-b",
         default_value_t = 1744.0,
         value_name = "METRES",
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        hide_default_value = true
     )]
-    pub d_b: f64,
+    d_b: f64,
 
-    /// l_d: length of a depth (radial) tile edge in metres, above 0.
+    /// l_d: length of a depth (radial) tile edge in metres, above 0 [preset's layout: 4; earth: 1].
     #[arg(
         long = "l-d",
         default_value_t = 4.0,
         value_name = "METRES",
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        hide_default_value = true
     )]
-    pub l_d: f64,
+    l_d: f64,
 
-    /// d_c: chunks along the depth axis. The planet radius is d_b + l_d * n_t * d_c.
-    #[arg(long = "d-c", default_value_t = 2, value_name = "N")]
-    pub d_c: u32,
+    /// d_c: chunks along the depth axis. The planet radius is d_b + l_d * n_t * d_c
+    /// [preset's layout: 2; earth: 1024].
+    #[arg(long = "d-c", default_value_t = 2, value_name = "N", hide_default_value = true)]
+    d_c: u32,
 }
 
 fn parse_preset(s: &str) -> Result<PresetKind, String> {
     s.parse::<PresetKind>().map_err(|e| e.to_string())
 }
 
+/// Preset, seed and layout (`--radius`, or the parameters of seed 000 Sec. 4.3 under the
+/// paper's names). The layout fields hold what was typed, or the default planet's value when
+/// nothing was; [`PlanetArgs::layout`] resolves them against the preset's layout.
+#[derive(Debug, Clone)]
+pub struct PlanetArgs {
+    /// Terrain preset.
+    pub preset: PresetKind,
+    /// Noise seed.
+    pub seed: u64,
+    /// Planet radius in metres, if `--radius` was given.
+    pub radius: Option<f64>,
+    /// `n_c` as typed (or 8).
+    pub n_c: u32,
+    /// `n_t` as typed (or 32).
+    pub n_t: u32,
+    /// `d_b` as typed (or 1744).
+    pub d_b: f64,
+    /// `l_d` as typed (or 4).
+    pub l_d: f64,
+    /// `d_c` as typed (or 2).
+    pub d_c: u32,
+    /// Which of the five layout options were typed, in [`LAYOUT_IDS`] order.
+    typed: [bool; 5],
+}
+
+impl FromArgMatches for PlanetArgs {
+    fn from_arg_matches(matches: &ArgMatches) -> Result<Self, clap::Error> {
+        let o = PlanetOptions::from_arg_matches(matches)?;
+        let typed = LAYOUT_IDS.map(|id| matches.value_source(id) == Some(ValueSource::CommandLine));
+        Ok(PlanetArgs {
+            preset: o.preset,
+            seed: o.seed,
+            radius: o.radius,
+            n_c: o.n_c,
+            n_t: o.n_t,
+            d_b: o.d_b,
+            l_d: o.l_d,
+            d_c: o.d_c,
+            typed,
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+        *self = PlanetArgs::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+impl Args for PlanetArgs {
+    fn group_id() -> Option<clap::Id> {
+        PlanetOptions::group_id()
+    }
+    fn augment_args(cmd: Command) -> Command {
+        PlanetOptions::augment_args(cmd)
+    }
+    fn augment_args_for_update(cmd: Command) -> Command {
+        PlanetOptions::augment_args_for_update(cmd)
+    }
+}
+
 impl PlanetArgs {
-    /// The validated layout.
-    pub fn layout(&self) -> Result<Layout, LayoutError> {
-        Layout::new(self.n_c, self.n_t, self.d_b, self.l_d, self.d_c)
+    /// The validated layout: the preset's layout for `--radius`, or the preset's own layout with
+    /// each typed layout option replacing its parameter.
+    pub fn layout(&self) -> Result<Layout, CliError> {
+        if let Some(r) = self.radius {
+            return Ok(self.preset.default_layout(Some(r))?);
+        }
+        let base = self.preset.default_layout(None)?;
+        let pick = |i: usize| self.typed[i];
+        Ok(Layout::new(
+            if pick(0) { self.n_c } else { base.n_c() },
+            if pick(1) { self.n_t } else { base.n_t() },
+            if pick(2) { self.d_b } else { base.d_b() },
+            if pick(3) { self.l_d } else { base.l_d() },
+            if pick(4) { self.d_c } else { base.d_c() },
+        )?)
     }
 
     /// Builds the planet.
-    pub fn planet(&self) -> Result<Planet, LayoutError> {
+    pub fn planet(&self) -> Result<Planet, CliError> {
         Ok(Planet::new(self.preset, self.seed, self.layout()?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        planet: PlanetArgs,
+    }
+
+    fn layout(args: &[&str]) -> Result<Layout, String> {
+        let cli = Cli::try_parse_from(std::iter::once("pmc").chain(args.iter().copied())).map_err(|e| e.to_string())?;
+        cli.planet.layout().map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn layouts_follow_the_preset_radius_and_typed_options() {
+        assert_eq!(layout(&[]).unwrap(), Layout::default());
+        let earth = PresetKind::Earth.default_layout(None).unwrap();
+        assert_eq!(layout(&["--preset", "earth"]).unwrap(), earth);
+        // A typed option replaces only its parameter of the preset's layout.
+        let l = layout(&["--preset", "earth", "--d-c", "2048"]).unwrap();
+        assert_eq!(
+            (l.n_c(), l.d_b(), l.l_d(), l.d_c()),
+            (earth.n_c(), earth.d_b(), 1.0, 2048)
+        );
+        let l = layout(&["--preset", "moon", "--n-c", "16"]).unwrap();
+        assert_eq!((l.n_c(), l.d_b(), l.d_c()), (16, 1744.0, 2));
+        // Typing the default value still counts as typed.
+        let l = layout(&["--preset", "earth", "--n-c", "8"]).unwrap();
+        assert_eq!((l.n_c(), l.d_c()), (8, 1024));
+        let moon = layout(&["--preset", "moon", "--radius", "1737400"]).unwrap();
+        assert_eq!(moon, PresetKind::Moon.default_layout(Some(1_737_400.0)).unwrap());
+    }
+
+    #[test]
+    fn radius_errors_are_clear() {
+        let e = layout(&["--radius", "5000", "--n-c", "4"]).unwrap_err();
+        assert!(e.contains("--radius") && e.contains("--n-c"), "{e}");
+        for (r, needle) in [
+            ("-5", "above 0"),
+            ("0", "above 0"),
+            ("NaN", "finite"),
+            ("1e9", "between"),
+            ("50", "between"),
+        ] {
+            let e = layout(&["--radius", r]).unwrap_err();
+            assert!(e.contains(needle), "{r}: {e}");
+        }
+        assert!(layout(&["--radius", "abc"]).unwrap_err().contains("--radius"));
     }
 }

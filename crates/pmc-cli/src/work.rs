@@ -79,3 +79,37 @@ pub fn mesh_planet(planet: &Planet, pool: &rayon::ThreadPool, quiet: bool) -> Ve
     bar.finish_and_clear();
     meshes
 }
+
+/// Meshes the chunks `keys` of `planet` on `pool` (level-of-detail meshes without seams: one
+/// level throughout), with a progress bar on stderr unless `quiet`. Returns the non-empty
+/// meshes in key order.
+pub fn mesh_chunks(
+    planet: &Planet,
+    keys: &[pmc_geometry::ChunkKey],
+    pool: &rayon::ThreadPool,
+    quiet: bool,
+) -> Vec<ChunkMesh> {
+    use rayon::prelude::*;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(keys.len() as u64), ProgressDrawTarget::stderr())
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} meshing chunks {bar:40} {pos}/{len} ({elapsed}, eta {eta})")
+            .expect("valid template"),
+    );
+    let mut meshes: Vec<ChunkMesh> = pool.install(|| {
+        keys.par_iter()
+            .map_init(pmc_planet::ChunkScratch::default, |scratch, key| {
+                let mut m = ChunkMesh::default();
+                planet.chunk_mesh_lod_into(*key, pmc_geometry::SideMask::NONE, scratch, &mut m);
+                bar.inc(1);
+                m
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    meshes.retain(|m| !m.is_empty());
+    meshes
+}

@@ -48,6 +48,100 @@ fn info_prints_the_paper_formulas() {
 }
 
 #[test]
+fn info_describes_the_earth_and_its_levels_of_detail() {
+    let o = pmc(&["info", "--preset", "earth"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = String::from_utf8(o.stdout).unwrap();
+    for needle in [
+        "n_c = 262144, n_t = 32, d_b = 6354616 m, l_d = 1 m, d_c = 1024",
+        "sea          radius 6371000.00 m",
+        "19 levels of detail, 0 to 18",
+    ] {
+        assert!(s.contains(needle), "no '{needle}' in:\n{s}");
+    }
+    // One table row per level, from 1 m voxels to one chunk per face side.
+    let rows: Vec<Vec<&str>> = s
+        .lines()
+        .map(|l| l.split_whitespace().collect::<Vec<_>>())
+        .filter(|w| w.len() > 3 && w[0].parse::<u8>().is_ok() && w[1].parse::<u64>().is_ok())
+        .collect();
+    assert_eq!(rows.len(), 19, "{s}");
+    assert_eq!(rows[0][..3], ["0", "262144", "1024"]);
+    assert_eq!(rows[18][..3], ["18", "1", "1"]);
+
+    let o = pmc(&["info", "--preset", "earth", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["layout"]["n_c"], 262144);
+    assert_eq!(v["layout"]["d_c"], 1024);
+    assert_eq!(v["sea_radius"], 6_371_000.0);
+    assert_eq!(v["max_level"], 18);
+    let levels = v["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 19);
+    for (l, level) in levels.iter().enumerate() {
+        let f = |k: &str| level[k].as_f64().unwrap();
+        let scale = (1u64 << l) as f64;
+        assert_eq!(level["level"], l);
+        assert_eq!(level["chunks_per_side"], 262144 >> l);
+        assert_eq!(f("voxel_radial"), scale);
+        assert_eq!(f("chunk_deep"), 32.0 * scale);
+        // Voxels about 1.2 m across on average: between 0.8 and 1.6 m at level 0, doubling.
+        let (lo, hi) = (f("voxel_across_min") / scale, f("voxel_across_max") / scale);
+        assert!(0.8 < lo && lo < hi && hi < 1.6, "level {l}: {lo} .. {hi}");
+        assert!((f("chunk_across") / (32.0 * scale) - 1.196).abs() < 0.01);
+    }
+    assert_eq!(levels[10]["depth_chunks"], 1);
+}
+
+#[test]
+fn radius_picks_a_layout_for_any_preset() {
+    let o = pmc(&["info", "--preset", "moon", "--radius", "1737400", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["preset"], "moon");
+    assert_eq!(v["layout"]["n_c"], 65536);
+    assert_eq!(v["layout"]["l_d"], 1.0);
+    assert_eq!(v["layout"]["d_c"], 512);
+    // The middle of the shell lies at the radius asked for.
+    assert_eq!(v["layout"]["d_b"], 1_737_400.0 - 8192.0);
+    assert_eq!(v["radius"], 1_737_400.0 + 8192.0);
+    assert_eq!(v["levels"].as_array().unwrap().len(), 17);
+    let o = pmc(&["info", "--preset", "moon", "--radius", "1737400"]);
+    let s = String::from_utf8(o.stdout).unwrap();
+    assert!(s.contains("17 levels of detail"), "{s}");
+    // The earth preset shrunk: its sea at the radius.
+    let o = pmc(&["info", "--preset", "earth", "--radius", "50000", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["sea_radius"], 50_000.0);
+    // A typed layout option replaces that parameter of the preset's layout.
+    let o = pmc(&["info", "--preset", "earth", "--d-c", "512", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["layout"]["n_c"], 262144);
+    assert_eq!(v["layout"]["d_c"], 512);
+}
+
+#[test]
+fn bad_radii_are_refused_clearly() {
+    for (r, needle) in [
+        ("0", "above 0"),
+        ("-5", "above 0"),
+        ("NaN", "finite"),
+        ("inf", "finite"),
+        ("50", "between 100 m"),
+        ("1e9", "between 100 m"),
+        ("abc", "--radius"),
+    ] {
+        assert_refused(&["info", "--radius", r], needle);
+        assert_eq!(pmc(&["info", "--radius", r]).status.code(), Some(2), "{r}");
+    }
+    assert_refused(&["info", "--radius", "5000", "--n-c", "4"], "cannot be used with");
+    assert_refused(&["generate", "--radius", "5000", "--d-b", "100"], "cannot be used with");
+    // Planets too large to mesh whole stay refused before any work.
+    assert_refused(&["generate", "--preset", "earth"], "too large");
+    assert_refused(&["render", "--preset", "moon", "--radius", "1737400"], "too large");
+}
+
+#[test]
 fn generate_writes_a_glb_and_is_deterministic_across_thread_counts() {
     let a = tmp("a.glb");
     let b = tmp("b.glb");
@@ -143,13 +237,14 @@ fn help_explains_every_option() {
         "--d-b",
         "--l-d",
         "--d-c",
+        "--radius",
         "--output",
         "--threads",
         "--quiet",
     ] {
         assert!(s.contains(opt), "--help lacks {opt}");
     }
-    assert!(s.contains("earthlike") && s.contains("moon") && s.contains("mars"));
+    assert!(s.contains("earthlike") && s.contains("moon") && s.contains("mars") && s.contains("earth ("));
 }
 
 #[test]

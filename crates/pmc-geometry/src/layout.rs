@@ -129,15 +129,18 @@ impl Layout {
 
     /// Eq. (2): the number of chunks, `6 n_c^2 d_c`.
     pub fn chunk_count(&self) -> u64 {
-        6 * u64::from(self.n_c).pow(2) * u64::from(self.d_c)
+        6u64.saturating_mul(u64::from(self.n_c).pow(2))
+            .saturating_mul(u64::from(self.d_c))
     }
 
     /// Eq. (3): the number of voxels counted per face, `6 (n_t n_c + 1)^2 (n_t d_c + 1)`. Voxels
-    /// on face edges count once per face; see [`Layout::unique_voxel_count`].
+    /// on face edges count once per face; see [`Layout::unique_voxel_count`]. Saturates at
+    /// `u64::MAX` on layouts whose count does not fit (the largest Earth-sized ones).
     pub fn voxel_count(&self) -> u64 {
         let n = self.face_tiles() as u64;
         let d = self.depth_tiles() as u64;
-        6 * (n + 1).pow(2) * (d + 1)
+        // Saturates instead of overflowing on the largest layouts (about 1.6e22 voxels).
+        6u64.saturating_mul((n + 1).saturating_pow(2)).saturating_mul(d + 1)
     }
 
     /// The number of distinct voxels once face-edge and corner voxels are paired:
@@ -145,7 +148,9 @@ impl Layout {
     pub fn unique_voxel_count(&self) -> u64 {
         let n = self.face_tiles() as u64;
         let d = self.depth_tiles() as u64;
-        (6 * n * n + 2) * (d + 1)
+        6u64.saturating_mul(n.saturating_mul(n))
+            .saturating_add(2)
+            .saturating_mul(d + 1)
     }
 
     /// Eq. (4): the planet radius `d_b + l_d n_t d_c` (the outermost voxel layer), in metres.
@@ -525,6 +530,14 @@ mod level_tests {
             k: 0,
         };
         assert_eq!(l.seam_sides(&top), SideMask::NONE);
+    }
+
+    #[test]
+    fn counts_of_the_largest_layouts_saturate_instead_of_overflowing() {
+        let l = Layout::new(1 << 19, 32, 6.0e6, 1.0, 1 << 19).unwrap();
+        assert_eq!(l.voxel_count(), u64::MAX);
+        assert_eq!(l.unique_voxel_count(), u64::MAX);
+        assert!(l.chunk_count() > 0);
     }
 
     #[test]

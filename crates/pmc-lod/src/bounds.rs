@@ -139,10 +139,18 @@ fn column_cap(layout: &Layout, face: Face, level: u8, i: u32, j: u32) -> Cap {
 /// The radii of the lowest and highest voxel layer of chunks `k` of `level`.
 fn layer_range(layout: &Layout, level: u8, k: u32) -> (f64, f64) {
     let s = span(layout, level);
-    (
-        layout.layer_radius(i64::from(k) * s),
-        layout.layer_radius(i64::from(k + 1) * s),
-    )
+    let (lo, hi) = (i64::from(k) * s, (i64::from(k + 1) * s).min(vertex_top(layout, level)));
+    (layout.layer_radius(lo), layout.layer_radius(hi.max(lo)))
+}
+
+/// The highest layer a level-`level` vertex can reach: a vertex lies on an edge with a solid
+/// end, solid voxels lie below the shell's top layer `D` (the shell contract makes every layer
+/// from `D` up air), so no vertex lies above the first layer of the level's stride at or past
+/// `D`. This keeps the spheres of coarse chunks that overhang the shell tight.
+fn vertex_top(layout: &Layout, level: u8) -> i64 {
+    let stride = 1i64 << level;
+    let d = layout.depth_tiles();
+    (d + stride - 1) / stride * stride
 }
 
 /// A sphere that holds every vertex chunk `key` can have. `key` must be a chunk of `layout`.
@@ -160,14 +168,14 @@ fn max_chunk_radius(layout: &Layout, level: u8) -> f64 {
     let angle = LIPSCHITZ * (std::f64::consts::SQRT_2 * s / n + (1u64 << level) as f64 / n);
     // The outermost layer any chunk of the level reaches: past the shell's top for coarse levels
     // whose depth chunks overhang it.
-    let r = layout
-        .radius()
-        .max(layout.layer_radius(i64::from(layout.depth_chunks(level)) * span(layout, level)));
+    let r = layout.radius().max(layout.layer_radius(vertex_top(layout, level)));
     if angle >= MAX_CAP_ANGLE {
         return 2.0 * r;
     }
     // The sphere centred at h = r1 has radius^2 <= w^2 + 4 r^2 sin^2(angle / 2).
-    let w = s * layout.l_d();
+    // The radial extent of the vertices: a chunk's layers, cut at the highest layer a vertex
+    // can reach (see `vertex_top`).
+    let w = s.min(vertex_top(layout, level) as f64) * layout.l_d();
     let sin = (0.5 * angle).sin();
     (w * w + 4.0 * r * r * sin * sin).sqrt() * RADIUS_FACTOR + 1e-9 * r
 }
@@ -331,7 +339,7 @@ mod tests {
     }
 
     #[test]
-    fn spheres_hold_every_vertex_and_voxel_and_are_tight() {
+    fn spheres_hold_every_vertex_and_reachable_voxel_and_are_tight() {
         for layout in layouts() {
             for preset in [PresetKind::Sphere, PresetKind::Earthlike, PresetKind::Moon] {
                 let planet = Planet::new(preset, 5, layout);
@@ -343,10 +351,13 @@ mod tests {
                             let d = (m.world_position(v) - s.center).length();
                             assert!(d <= s.radius, "{key}: vertex at {d} outside {}", s.radius);
                         }
-                        // The voxels of the chunk, and how tight the sphere is around them.
+                        // The voxels of the chunk a vertex can touch (up to the first layer of
+                        // the level at or past the shell's top), and how tight the sphere is
+                        // around them.
                         let grid = pmc_geometry::ChunkGrid::new(&layout, key);
+                        let top = vertex_top(&layout, level);
                         let mut far: f64 = 0.0;
-                        for c in 1..=grid.tiles + 1 {
+                        for c in (1..=grid.tiles + 1).filter(|c| grid.k0 + (*c as i64 - 1) * grid.stride <= top) {
                             for b in 1..=grid.tiles + 1 {
                                 for a in 1..=grid.tiles + 1 {
                                     far = far.max((grid.position(a, b, c) - s.center).length());

@@ -80,9 +80,11 @@ mod adjacency;
 pub mod bounds;
 mod cull;
 mod errors;
+mod region;
 mod select;
 
 pub use adjacency::{adjacent, OFFSETS};
 pub use cull::{frustum_planes, occluder_radius, sphere_below_horizon, sphere_in_frustum};
 pub use errors::{measure_level_errors, CELLS_PER_CHUNK, MIN_GRADIENT};
+pub use region::{level_for_error, region_chunks, RegionError};
 pub use select::{LodError, LodParams, Selected, Selection, Selector, View, DEFAULT_MAX_CHUNKS};

@@ -39,7 +39,7 @@ async fn planet_describes_the_planet() {
         .iter()
         .map(|p| p["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["sphere", "earthlike", "moon", "mars"]);
+    assert_eq!(names, ["sphere", "earthlike", "moon", "mars", "earth"]);
     assert!(v["presets"][1]["description"].as_str().unwrap().contains("continents"));
     assert_eq!(
         v["layout"],

@@ -96,5 +96,16 @@ export function chunkSphere(layout: Layout, key: ChunkKey): BoundingSphere {
   const ti = key.i * s;
   const tj = key.j * s;
   const cap = rectCap(key.face, uv(ti, n), uv(ti + s, n), uv(tj, n), uv(tj + s, n), layout.n_t);
-  return capSphere(cap, layout.layerRadius(key.k * s), layout.layerRadius((key.k + 1) * s));
+  const lo = key.k * s;
+  const hi = Math.max(lo, Math.min((key.k + 1) * s, vertexTop(layout, key.level)));
+  return capSphere(cap, layout.layerRadius(lo), layout.layerRadius(hi));
+}
+
+/**
+ * The highest layer a vertex of the level can reach: the first layer of the level's stride at
+ * or past the shell's top `D` (every layer from `D` up is air), as in the Rust crate.
+ */
+export function vertexTop(layout: Layout, level: number): number {
+  const stride = 2 ** level;
+  return Math.ceil(layout.depthTiles() / stride) * stride;
 }

@@ -207,6 +207,13 @@ impl Spaghetti {
         }
     }
 
+    /// The lowest value the tube part of the field takes, `-t S` (metres, negative): inside its
+    /// band the field is never below it, so carving lowers the density by at most that much
+    /// below zero.
+    pub fn floor(&self) -> f64 {
+        self.neg_ts
+    }
+
     /// How far below a band's bottom a tube can still open air.
     pub fn reach_below(&self) -> f64 {
         self.threshold * self.scale / self.slope

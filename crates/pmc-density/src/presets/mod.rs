@@ -1,8 +1,10 @@
 //! Terrain presets: a density, a sea level and a shader, built for a layout and a seed.
 
 mod craters;
+mod earth;
 mod earthlike;
 mod features;
+mod layouts;
 mod mars;
 mod moon;
 mod shading;
@@ -11,6 +13,7 @@ mod sphere;
 mod testing;
 
 use crate::Density;
+pub use layouts::{layout_for_radius, RadiusError, EARTH_RADIUS, MAX_RADIUS, MIN_RADIUS};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -26,15 +29,20 @@ pub enum PresetKind {
     Moon,
     /// Red, dry, with canyons, volcanoes, dunes, polar caps and caves.
     Mars,
+    /// The Earth at true scale on its own layout ([`PresetKind::default_layout`]): sea level at
+    /// 6 371 000 m, ocean basins, trenches, mountain ranges, hills, rocks, cliffs and caves down
+    /// to 1 m voxels; the same planet shrunk onto any other layout.
+    Earth,
 }
 
 impl PresetKind {
     /// Every preset, in the order `--help` lists them.
-    pub const ALL: [PresetKind; 4] = [
+    pub const ALL: [PresetKind; 5] = [
         PresetKind::Sphere,
         PresetKind::Earthlike,
         PresetKind::Moon,
         PresetKind::Mars,
+        PresetKind::Earth,
     ];
 
     /// The preset's command-line name.
@@ -44,6 +52,7 @@ impl PresetKind {
             PresetKind::Earthlike => "earthlike",
             PresetKind::Moon => "moon",
             PresetKind::Mars => "mars",
+            PresetKind::Earth => "earth",
         }
     }
 
@@ -54,6 +63,9 @@ impl PresetKind {
             PresetKind::Earthlike => "continents, seas, ridged mountains, caves and overhangs",
             PresetKind::Moon => "grey cratered highlands and maria, lava tubes, no sea",
             PresetKind::Mars => "red deserts, canyons, volcanoes, polar caps and caves, no sea",
+            PresetKind::Earth => {
+                "the Earth at true scale: oceans, trenches, continents, mountain ranges, hills, rocks, cliffs and caves, 1 m voxels"
+            }
         }
     }
 }
@@ -66,7 +78,7 @@ impl std::fmt::Display for PresetKind {
 
 /// An unknown preset name.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown preset '{0}' (choose one of: sphere, earthlike, moon, mars)")]
+#[error("unknown preset '{0}' (choose one of: sphere, earthlike, moon, mars, earth)")]
 pub struct UnknownPreset(pub String);
 
 impl std::str::FromStr for PresetKind {
@@ -141,15 +153,18 @@ impl std::fmt::Debug for Terrain {
 /// Builds the terrain of `kind` for `layout` and `seed`.
 ///
 /// Scales follow the layout: relief is set in fractions of the shell thickness
-/// `T = l_d n_t d_c`, horizontal noise frequencies relative to the planet radius (3D noise on the
-/// unit sphere, seed 000 Sec. 4.6), caves and overhangs in voxel depths `l_d` and horizontal tile
+/// `T = l_d n_t d_c` (the earth preset: in metres times `T / 32 768 m`, so true scale on its own
+/// layout), horizontal noise frequencies relative to the planet radius (3D noise on the unit
+/// sphere, seed 000 Sec. 4.6), caves and overhangs in voxel depths `l_d` and horizontal tile
 /// sizes `(pi / 2) R / (n_c n_t)`. The same kind, seed and layout give bit-identical terrain.
+/// [`PresetKind::default_layout`] gives each preset's own layout.
 pub fn build(kind: PresetKind, seed: u64, layout: &Layout) -> Terrain {
     match kind {
         PresetKind::Sphere => sphere::build(seed, layout),
         PresetKind::Earthlike => earthlike::build(seed, layout),
         PresetKind::Moon => moon::build(seed, layout),
         PresetKind::Mars => mars::build(seed, layout),
+        PresetKind::Earth => earth::build(seed, layout),
     }
 }
 
@@ -196,7 +211,11 @@ mod tests {
                 );
                 assert_eq!(s.color[3], 255);
             }
-            assert_eq!(a.sea_radius.is_some(), kind == PresetKind::Earthlike, "{kind}");
+            assert_eq!(
+                a.sea_radius.is_some(),
+                matches!(kind, PresetKind::Earthlike | PresetKind::Earth),
+                "{kind}"
+            );
         }
     }
 

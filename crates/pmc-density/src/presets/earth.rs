@@ -1,0 +1,1182 @@
+//! The earth preset: the Earth at true scale on its own layout (sea level at 6 371 000 m, 1 m
+//! voxels), and the same planet shrunk onto any other layout.
+//!
+//! # Scales
+//!
+//! Heights below are metres at true scale. On a layout with shell thickness `T` they are scaled
+//! by `v = T / 32 768 m` (exactly 1 on the earth layout), and horizontal sizes are angles, so a
+//! smaller planet is the same planet shrunk. Metre-scale features (rocks, cliffs, caves) are sized
+//! in voxels instead: `l_d` deep (1 m at true scale) and tiles across (about 1.2 m), capped by
+//! fractions of `T`. Height-field detail stops at two tiles (finer octaves would only alias). The
+//! sea lies in the middle of the shell, `d_b + T/2`.
+//!
+//! | feature | height | horizontal scale |
+//! |---|---|---|
+//! | continents, ocean basins | shelf -150 m, ocean floor -2.9 to -5.5 km; lowlands up to +450 m, plateaus up to +1.1 km | continent cells about 5 500 km; about 30% land |
+//! | trenches | down to 4.5 km under the ocean floor (about -10 km) | arcs about 300 km wide along a noise zero set |
+//! | regional swell | +-320 m at 600 km, gain 0.8 | 600 km to 70 km |
+//! | mountain ranges | ridged multifractal, squared, up to 9.5 km | belts about 800 km wide, ridges 150 km down to 25 m |
+//! | hills | +-150 m at 35 km, amplitude as wavelength^0.75, times a hilliness of 0.35 to 3 | 35 km down to 2 tiles |
+//! | rocks | +-1.2 m at 30 m (height field), and 3D bumps of 1.2 `l_d` | 30 m down to 2 tiles; bumps 4 tiles across, 3 `l_d` deep |
+//! | cliffs, overhangs | 3D displacement up to 9 `l_d` on mountain slopes, folding the surface | 20 tiles across, 7 `l_d` deep |
+//! | caves | tubes from 56 `l_d` (at most 0.08 T) under the surface up to a roof 4 `l_d` under it, or 3 `l_d` above it where the roof opens (cave mouths); on land, above sea level | tubes about 5 tiles wide and 4 `l_d` tall, about 26 tiles apart |
+//!
+//! # A signed distance everywhere in the shell
+//!
+//! The density is `h(dir) - r` (metres) plus the 3D terms (rocks, cliffs, caves), which are
+//! exactly zero more than `W` from `h` (`W` under 70 `l_d` below, 18 `l_d` above, per column), so
+//! far above and below the surface it is the radial distance to it, and coarse levels of detail,
+//! whose layers may be kilometres apart, place the surface by interpolating it.
+//!
+//! # Cost: the height field is band-limited by the distance to the surface
+//!
+//! A column first computes its coarse fields once (continents, basins, trenches, plateaus,
+//! mountain belts, hilliness, cave regions: 8 to 14 noise lattices). The detail of `h` is a
+//! ladder of 35 octaves at true scale (regional swell, ridges, hills, rocks) ordered from the longest
+//! wavelength to the shortest; after `k` of them the height `h_k` is known to within a sound
+//! bound `B_k` (every octave's amplitude is known from the coarse fields; the squared ridge term
+//! is bounded by `B (2 R_k + B)`). A sample at radius `r` stops at the first `k` with
+//! `|h_k - r| >= max(8 B_k, B_k + W)` and returns `h_k - r`: the sign is that of the full
+//! formula, the value within 1/8 of it, and the 3D terms are certainly zero there. The stopping
+//! rule depends on the sample alone (never on the batch), so every chunk that holds a voxel
+//! computes the same bits for it. A batch advances each column's ladder only as far as its
+//! furthest-reaching radius needs: a chunk kilometres from the surface costs a few coarse
+//! octaves per column; a chunk at the surface evaluates the whole ladder once per column and
+//! the 3D terms only in the band around the surface.
+
+use super::features::{lerp, smoothstep, CaveBand, Scales, Spaghetti, Stretch};
+use super::layouts::EARTH_RADIUS;
+use super::shading::{Material, Palette};
+use super::{PresetKind, Shade, Shader, Terrain};
+use crate::noise::{derive_seed, gradient3, mix64, unit_f64, Fbm, FbmParams, DEFAULT_LACUNARITY};
+use crate::Density;
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::Layout;
+use std::sync::Arc;
+
+/// Material names, indexed by [`Shade::material`].
+pub(crate) const MATERIALS: &[&str] = &["seabed", "sand", "grass", "forest", "rock", "snow", "cave"];
+const SEABED: u8 = 0;
+const SAND: u8 = 1;
+const GRASS: u8 = 2;
+const FOREST: u8 = 3;
+const ROCK: u8 = 4;
+const SNOW: u8 = 5;
+const CAVE: u8 = 6;
+
+/// The shell thickness of the true-scale layout: heights are metres for it, scaled by
+/// `T / TRUE_THICKNESS` on other layouts.
+pub(crate) const TRUE_THICKNESS: f64 = 32_768.0;
+
+/// Continents: cells per unit of direction, octaves, and the offset that sets the land fraction.
+const CONT_FREQ: f64 = 1.15;
+const CONT_OCTAVES: u32 = 7;
+const CONT_BIAS: f64 = -0.085;
+/// Ocean: shelf depth, mean abyssal depth and its variation between basins (metres).
+const SHELF_DEPTH: f64 = 150.0;
+const ABYSS_DEPTH: f64 = 4200.0;
+const ABYSS_VARIATION: f64 = 1300.0;
+const BASIN_FREQ: f64 = 0.9;
+/// Trenches: extra depth (metres), cells per unit of direction of their lines and of their gate.
+const TRENCH_DEPTH: f64 = 4500.0;
+const TRENCH_FREQ: f64 = 1.3;
+const TRENCH_GATE_FREQ: f64 = 2.2;
+/// Land: rise of the lowlands inland and height of the plateaus (metres).
+const LOWLAND_RISE: f64 = 450.0;
+const PLATEAU_HEIGHT: f64 = 1100.0;
+const PLATEAU_FREQ: f64 = 1.6;
+/// Mountain belts: cells per unit of direction, and the highest ridge (metres).
+const BELT_FREQ: f64 = 1.5;
+const MOUNTAIN_HEIGHT: f64 = 9500.0;
+/// Hilliness: cells per unit of direction.
+const HILLINESS_FREQ: f64 = 9.0;
+
+/// The detail ladder: wavelengths `LADDER_TOP / 2.03^i` (true-scale metres).
+const LADDER_TOP: f64 = 600_000.0;
+/// At most this many rungs (the last one is about 2 cm at true scale: never reached).
+const LADDER_RUNGS: usize = 24;
+/// Room for every octave of every part of the ladder (a test checks the true-scale count).
+const MAX_ENTRIES: usize = 40;
+/// Regional swell: wavelengths at least this (metres), amplitude of the first octave, gain.
+const REGIONAL_MIN: f64 = 50_000.0;
+const REGIONAL_AMP: f64 = 320.0;
+const REGIONAL_GAIN: f64 = 0.8;
+/// Hills: amplitude at `HILLS_REF` metres, spectral exponent (amplitude ~ wavelength^exp).
+const HILLS_AMP: f64 = 150.0;
+const HILLS_REF: f64 = 35_000.0;
+const HILLS_EXP: f64 = 0.75;
+/// Ridges: wavelengths from `RIDGE_MAX` down to `RIDGE_MIN` metres, gain.
+const RIDGE_MAX: f64 = 170_000.0;
+const RIDGE_MIN: f64 = 25.0;
+const RIDGE_GAIN: f64 = 0.5;
+/// Rocks (height field): wavelengths up to `ROCK_MAX` metres, amplitude there, exponent.
+const ROCK_MAX: f64 = 32.0;
+const ROCK_AMP: f64 = 1.2;
+const ROCK_EXP: f64 = 0.72;
+/// Finest height-field detail, in tiles.
+const FINEST_TILES: f64 = 2.0;
+
+/// A sample stops refining once its distance from the partial height is this many times the
+/// bound on the remaining octaves (so a truncated value is within 1/8 of the full one).
+const STOP_FACTOR: f64 = 8.0;
+
+/// 3D rock bumps: amplitude (`l_d`, at most a fraction of `T`), lengths (tiles across, `l_d` deep).
+const ROCK3D_AMP: f64 = 1.2;
+const ROCK3D_CAP: f64 = 0.005;
+const ROCK3D_ACROSS: f64 = 4.0;
+const ROCK3D_DEEP: f64 = 3.0;
+/// Cliffs: displacement amplitude (`l_d`, at most a fraction of `T`), lengths, gate cells (tiles).
+const CLIFF_AMP: f64 = 9.0;
+const CLIFF_CAP: f64 = 0.02;
+const CLIFF_ACROSS: f64 = 20.0;
+const CLIFF_DEEP: f64 = 7.0;
+const CLIFF_REGION: f64 = 1500.0;
+/// Caves: tube lengths (tiles across, `l_d` deep), threshold, band depth (`l_d`, at most a
+/// fraction of `T`), roof (`l_d`) and how far above the surface an open roof goes (`l_d`), the
+/// region size (tiles), and how fast the field closes outside its band (density per metre).
+const CAVE_ACROSS: f64 = 26.0;
+const CAVE_DEEP: f64 = 24.0;
+const CAVE_THRESHOLD: f64 = 0.1;
+const CAVE_BAND: f64 = 56.0;
+const CAVE_BAND_CAP: f64 = 0.08;
+const CAVE_ROOF: f64 = 4.0;
+const CAVE_MOUTH: f64 = 3.0;
+const CAVE_REGION: f64 = 300.0;
+const CAVE_SLOPE: f64 = 8.0;
+
+/// The parts of the detail ladder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Part {
+    Regional = 0,
+    Hills = 1,
+    Ridge = 2,
+    Rocks = 3,
+}
+
+/// One octave of the ladder.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    part: Part,
+    freq: f64,
+    offset: DVec3,
+    seed: u64,
+    /// Amplitude before the column's factor (for ridges: the share of the normalised sum).
+    amp: f64,
+}
+
+/// A column's coarse fields and its lazily refined height.
+#[derive(Clone, Debug)]
+pub(crate) struct EarthColumn {
+    /// Per-part amplitude factors in metres (Regional, Hills, Ridge = mountain height, Rocks).
+    factor: [f64; 4],
+    /// Mountain mask in `[0, 1]`.
+    pub mountains: f64,
+    /// 3D rock and cliff amplitudes (metres).
+    a_rock: f64,
+    a_cliff: f64,
+    /// Cave gate in `[0, 1]` and roof depth (metres, negative where the roof opens).
+    cave_gate: f64,
+    roof: f64,
+    /// Reach of the 3D terms below and above `h`.
+    w_down: f64,
+    w_up: f64,
+    /// Ladder state: entries done, the linear sum, the ridge sum and weight.
+    done: usize,
+    linear: f64,
+    ridge: f64,
+    weight: f64,
+    /// After `k` entries: the height, and the radii between which samples go on refining.
+    h: [f64; MAX_ENTRIES + 1],
+    keep_lo: [f64; MAX_ENTRIES + 1],
+    keep_hi: [f64; MAX_ENTRIES + 1],
+    /// The bound on the remaining octaves after `k` entries.
+    rem: [f64; MAX_ENTRIES + 1],
+}
+
+impl EarthColumn {
+    /// The height after the last evaluated entry.
+    pub fn height(&self) -> f64 {
+        self.h[self.done]
+    }
+
+    /// Whether a sample at `r` goes on refining after `k` entries.
+    #[inline]
+    fn keeps(&self, k: usize, r: f64) -> bool {
+        self.keep_lo[k] < r && r < self.keep_hi[k]
+    }
+}
+
+/// The earth density model.
+pub(crate) struct EarthModel {
+    s: Scales,
+    sea: f64,
+    vert: f64,
+    continents: Fbm,
+    basins: Fbm,
+    trenches: Fbm,
+    trench_gate_seed: u64,
+    plateaus: Fbm,
+    belts: Fbm,
+    hilliness_seed: u64,
+    entries: Vec<Entry>,
+    /// `suffix[p][k]`: the sum of the amplitudes of part `p` from entry `k` on.
+    suffix: [Vec<f64>; 4],
+    cliff_seed: u64,
+    cliff_freq: f64,
+    rock3d: Stretch,
+    rock3d_seed: u64,
+    rock3d_amp: f64,
+    cliff: Stretch,
+    cliff_seed3d: u64,
+    cliff_amp: f64,
+    falloff: f64,
+    caves: Spaghetti,
+    cave_band: f64,
+    region_seed: u64,
+    region_freq: f64,
+    bounds: (f64, f64),
+}
+
+impl EarthModel {
+    pub(crate) fn new(seed: u64, layout: &Layout) -> Self {
+        let s = Scales::new(layout);
+        let t = s.thickness;
+        let sea = s.shell(0.5);
+        let vert = t / TRUE_THICKNESS;
+        let ratio = sea / EARTH_RADIUS;
+        let entries = ladder(seed, ratio, s.tile);
+        let mut suffix: [Vec<f64>; 4] = Default::default();
+        for (p, sums) in suffix.iter_mut().enumerate() {
+            *sums = vec![0.0; entries.len() + 1];
+            for k in (0..entries.len()).rev() {
+                let e = &entries[k];
+                sums[k] = sums[k + 1] + if e.part as usize == p { e.amp } else { 0.0 };
+            }
+        }
+        let l_d = s.l_d;
+        let rock3d_amp = (ROCK3D_AMP * l_d).min(ROCK3D_CAP * t);
+        let cliff_amp = (CLIFF_AMP * l_d).min(CLIFF_CAP * t);
+        let cave_deep = (CAVE_DEEP * l_d).min(0.25 * t);
+        let caves = Spaghetti::new(
+            (derive_seed(seed, 60), derive_seed(seed, 61)),
+            CAVE_ACROSS * s.tile,
+            cave_deep,
+            sea,
+            CAVE_THRESHOLD,
+            CAVE_SLOPE,
+            t,
+        );
+        let cave_band = (CAVE_BAND * l_d).min(CAVE_BAND_CAP * t);
+        let falloff = l_d;
+        // Sound bounds: every term at its extreme (noise within [-1, 1], ridges within [0, 1],
+        // masks within [0, 1], the largest column factors), the 3D displacement at its largest.
+        let detail = |p: Part, f: f64| f * suffix[p as usize].first().copied().unwrap_or(0.0);
+        let hills_max = 1.7 + 1.3;
+        let rocks_max = 1.7;
+        let common = detail(Part::Regional, 1.0) + detail(Part::Hills, hills_max) + detail(Part::Rocks, rocks_max);
+        let deepest = ABYSS_DEPTH + ABYSS_VARIATION + TRENCH_DEPTH;
+        let highest = LOWLAND_RISE + PLATEAU_HEIGHT + MOUNTAIN_HEIGHT;
+        let a_max = rock3d_amp + cliff_amp;
+        let margin = 1e-6 * t;
+        let lowest_cave = sea + 2.0 * l_d + caves.floor() / CAVE_SLOPE;
+        let bounds = (
+            (sea - vert * (deepest + common) - a_max).min(lowest_cave) - margin,
+            sea + vert * (highest + common) + a_max + margin,
+        );
+        EarthModel {
+            s,
+            sea,
+            vert,
+            continents: Fbm::new(derive_seed(seed, 40), FbmParams::new(CONT_FREQ, CONT_OCTAVES)),
+            basins: Fbm::new(derive_seed(seed, 41), FbmParams::new(BASIN_FREQ, 2)),
+            trenches: Fbm::new(derive_seed(seed, 42), FbmParams::new(TRENCH_FREQ, 2)),
+            trench_gate_seed: derive_seed(seed, 43),
+            plateaus: Fbm::new(derive_seed(seed, 44), FbmParams::new(PLATEAU_FREQ, 2)),
+            belts: Fbm::new(derive_seed(seed, 45), FbmParams::new(BELT_FREQ, 2)),
+            hilliness_seed: derive_seed(seed, 46),
+            entries,
+            suffix,
+            cliff_seed: derive_seed(seed, 47),
+            cliff_freq: s.freq(CLIFF_REGION * s.tile),
+            rock3d: Stretch::new(ROCK3D_ACROSS * s.tile, (ROCK3D_DEEP * l_d).min(0.25 * t), sea),
+            rock3d_seed: derive_seed(seed, 48),
+            rock3d_amp,
+            cliff: Stretch::new(CLIFF_ACROSS * s.tile, (CLIFF_DEEP * l_d).min(0.25 * t), sea),
+            cliff_seed3d: derive_seed(seed, 49),
+            cliff_amp,
+            falloff,
+            caves,
+            cave_band,
+            region_seed: derive_seed(seed, 62),
+            region_freq: s.freq(CAVE_REGION * s.tile),
+            bounds,
+        }
+    }
+
+    /// The sea radius.
+    pub(crate) fn sea(&self) -> f64 {
+        self.sea
+    }
+
+    /// Number of octaves in the detail ladder.
+    #[cfg(test)]
+    pub(crate) fn ladder_len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// The coarse fields of the column along unit direction `dir` (no ladder entry evaluated).
+    pub(crate) fn column(&self, dir: DVec3) -> EarthColumn {
+        let v = self.vert;
+        let e = self.continents.sample(dir) + CONT_BIAS;
+        // Ocean: a shelf, then the abyssal floor (its depth varying between basins), and trenches
+        // along part of a noise zero set. Every noise is skipped where its factor is exactly zero.
+        let shelf = smoothstep(0.0, 0.012, -e);
+        let deep = smoothstep(0.02, 0.09, -e);
+        let mut depth = SHELF_DEPTH * shelf;
+        if deep > 0.0 {
+            let abyss = ABYSS_DEPTH + ABYSS_VARIATION * (3.0 * self.basins.sample(dir)).clamp(-1.0, 1.0);
+            depth += (abyss - SHELF_DEPTH) * deep;
+            let gate = smoothstep(0.05, 0.12, -e);
+            if gate > 0.0 {
+                let gate = gate * smoothstep(0.0, 0.25, gradient3(dir * TRENCH_GATE_FREQ, self.trench_gate_seed));
+                if gate > 0.0 {
+                    let line = 1.0 - smoothstep(0.0, 0.02, self.trenches.sample(dir).abs());
+                    depth += TRENCH_DEPTH * line * gate;
+                }
+            }
+        }
+        // Land: lowlands rising inland, plateaus, mountain belts along a noise zero set.
+        let mut height = LOWLAND_RISE * smoothstep(0.0, 0.15, e);
+        let plateau_gate = smoothstep(0.03, 0.12, e);
+        if plateau_gate > 0.0 {
+            height += PLATEAU_HEIGHT * plateau_gate * smoothstep(0.1, 0.45, self.plateaus.sample(dir));
+        }
+        let land_gate = smoothstep(0.005, 0.05, e);
+        let mountains = if land_gate > 0.0 {
+            (1.0 - smoothstep(0.015, 0.07, self.belts.sample(dir).abs())) * land_gate
+        } else {
+            0.0
+        };
+        let base = self.sea + v * (height - depth);
+        // Detail amplitudes: hills rougher where the hilliness noise is high and in mountains,
+        // calmer at sea; rocks rougher in the mountains.
+        let on_land = smoothstep(-0.015, 0.01, e);
+        let hilly = lerp(
+            0.35,
+            1.7,
+            smoothstep(-0.3, 0.35, gradient3(dir * HILLINESS_FREQ, self.hilliness_seed)),
+        ) + 1.3 * mountains;
+        let factor = [
+            v * lerp(0.7, 1.0, on_land),
+            v * hilly * lerp(0.6, 1.0, on_land),
+            v * MOUNTAIN_HEIGHT * mountains,
+            v * lerp(0.3, 0.7 + mountains, on_land),
+        ];
+        // 3D terms: rock bumps on land, cliffs in parts of the mountains, caves in regions of the
+        // land whose roof opens in places.
+        let a_rock = self.rock3d_amp * on_land;
+        let a_cliff = if mountains > 0.0 {
+            self.cliff_amp * mountains * smoothstep(-0.1, 0.3, gradient3(dir * self.cliff_freq, self.cliff_seed))
+        } else {
+            0.0
+        };
+        let cave_land = smoothstep(0.0, 0.015, e);
+        let (cave_gate, roof) = if cave_land > 0.0 {
+            let region = gradient3(dir * self.region_freq, self.region_seed);
+            let mouth = smoothstep(0.25, 0.45, region);
+            (
+                cave_land * smoothstep(-0.15, 0.05, region),
+                self.s.l_d * (CAVE_ROOF - (CAVE_ROOF + CAVE_MOUTH) * mouth),
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let a = a_rock + a_cliff;
+        let over = if a > 0.0 { 1.5 * a + self.falloff } else { 0.0 };
+        let (cave_down, cave_up) = if cave_gate > 0.0 {
+            // Under the band the field rises by CAVE_SLOPE per metre from its floor -tS, so it
+            // exceeds the plain distance h - r from (slope D + tS) / (slope - 1) under h; above
+            // the band's top (at most -roof above h) likewise, with h - r < 0.
+            let ts = -self.caves.floor();
+            (
+                (CAVE_SLOPE * self.cave_band + ts) / (CAVE_SLOPE - 1.0),
+                (CAVE_SLOPE * (-roof).max(0.0) + ts) / (CAVE_SLOPE + 1.0),
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let margin = self.s.l_d + 1e-6 * self.s.thickness;
+        let mut col = EarthColumn {
+            factor,
+            mountains,
+            a_rock,
+            a_cliff,
+            cave_gate,
+            roof,
+            w_down: over.max(cave_down) + margin,
+            w_up: over.max(cave_up) + margin,
+            done: 0,
+            linear: base,
+            ridge: 0.0,
+            weight: 1.0,
+            h: [0.0; MAX_ENTRIES + 1],
+            keep_lo: [0.0; MAX_ENTRIES + 1],
+            keep_hi: [0.0; MAX_ENTRIES + 1],
+            rem: [0.0; MAX_ENTRIES + 1],
+        };
+        col.h[0] = base;
+        self.set_keep(&mut col, 0, f64::NEG_INFINITY, f64::INFINITY);
+        col
+    }
+
+    /// Records the remaining bound after `k` entries and the radii that keep refining.
+    #[inline]
+    fn set_keep(&self, col: &mut EarthColumn, k: usize, lo: f64, hi: f64) {
+        let f = &col.factor;
+        let ridge_left = self.suffix[Part::Ridge as usize][k];
+        let rem = f[0] * self.suffix[0][k]
+            + f[1] * self.suffix[1][k]
+            + f[3] * self.suffix[3][k]
+            + f[2] * ridge_left * (2.0 * col.ridge + ridge_left);
+        let h = col.h[k];
+        col.rem[k] = rem;
+        col.keep_lo[k] = lo.max(h - (rem + col.w_down).max(STOP_FACTOR * rem));
+        col.keep_hi[k] = hi.min(h + (rem + col.w_up).max(STOP_FACTOR * rem));
+    }
+
+    /// Evaluates the next ladder entry of `col`.
+    fn advance(&self, col: &mut EarthColumn, dir: DVec3) {
+        let k = col.done;
+        let e = &self.entries[k];
+        let f = col.factor[e.part as usize];
+        if f > 0.0 {
+            let n = gradient3(dir * e.freq + e.offset, e.seed);
+            match e.part {
+                Part::Ridge => {
+                    let s = (1.0 - n.abs()) * (1.0 - n.abs()) * col.weight;
+                    col.weight = (2.0 * s).clamp(0.0, 1.0);
+                    col.ridge += e.amp * s;
+                }
+                _ => col.linear += f * e.amp * n,
+            }
+        }
+        col.done = k + 1;
+        col.h[k + 1] = col.linear + col.factor[Part::Ridge as usize] * col.ridge * col.ridge;
+        let (lo, hi) = (col.keep_lo[k], col.keep_hi[k]);
+        self.set_keep(col, k + 1, lo, hi);
+    }
+
+    /// Refines `col` until a sample at `r` stops (or the ladder ends).
+    fn refine_for(&self, col: &mut EarthColumn, dir: DVec3, r: f64) {
+        while col.done < self.entries.len() && col.keeps(col.done, r) {
+            self.advance(col, dir);
+        }
+    }
+
+    /// Refines `col` until its height is known within `tol` metres (or the ladder ends).
+    pub(crate) fn refine_to(&self, col: &mut EarthColumn, dir: DVec3, tol: f64) {
+        while col.done < self.entries.len() && col.rem[col.done] > tol {
+            self.advance(col, dir);
+        }
+    }
+
+    /// The full height of the column (every entry evaluated).
+    #[cfg(test)]
+    pub(crate) fn full_height(&self, col: &mut EarthColumn, dir: DVec3) -> f64 {
+        self.refine_to(col, dir, -1.0);
+        col.height()
+    }
+
+    /// The density at radius `r` of a column refined at least as far as `r` needs.
+    #[inline]
+    fn value(&self, col: &EarthColumn, dir: DVec3, r: f64) -> f64 {
+        // The first k at which the sample stops; `keeps` is monotone in k (nested intervals).
+        if !col.keeps(0, r) {
+            // Far from the surface: the coarse fields decide (the common case away from it).
+            return col.h[0] - r;
+        }
+        let n = col.done;
+        if col.keeps(n, r) {
+            debug_assert_eq!(n, self.entries.len());
+            return self.near_surface(col, dir, col.h[n], r);
+        }
+        let (mut lo, mut hi) = (1usize, n);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if col.keeps(mid, r) {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        col.h[lo] - r
+    }
+
+    /// The full formula near the surface: the height field displaced by rocks and cliffs, carved
+    /// by caves.
+    #[inline]
+    fn near_surface(&self, col: &EarthColumn, dir: DVec3, h: f64, r: f64) -> f64 {
+        let base = h - r;
+        let a = col.a_rock + col.a_cliff;
+        let mut d0 = base;
+        if a > 0.0 {
+            let reach = 1.5 * a + self.falloff;
+            let z = base.abs();
+            if z < reach {
+                let w = 1.0 - smoothstep(a, reach, z);
+                let mut n = col.a_rock * gradient3(self.rock3d.at(dir, r), self.rock3d_seed);
+                if col.a_cliff > 0.0 {
+                    n += col.a_cliff * gradient3(self.cliff.at(dir, r), self.cliff_seed3d);
+                }
+                d0 = base + w * n;
+            }
+        }
+        if col.cave_gate > 0.0 {
+            let bottom = (self.sea + 2.0 * self.s.l_d).max(h - self.cave_band);
+            let band: CaveBand = self.caves.band(bottom, h - col.roof, col.cave_gate);
+            d0 = self.caves.carve(d0, &band, dir, r);
+        }
+        d0
+    }
+
+    /// The density at `dir * r` with no shortcut: every ladder entry, the full 3D formula (for
+    /// tests; the radius is taken as `|dir * r|` like the batch does).
+    #[cfg(test)]
+    pub(crate) fn reference(&self, dir: DVec3, r: f64) -> f64 {
+        let r = (dir * r).length();
+        let mut col = self.column(dir);
+        let h = self.full_height(&mut col, dir);
+        self.near_surface(&col, dir, h, r)
+    }
+
+    /// Sound radial bounds on the surface.
+    pub(crate) fn bounds(&self) -> (f64, f64) {
+        self.bounds
+    }
+}
+
+/// Builds the detail ladder for a planet `ratio` times the Earth's size with tiles `tile` metres
+/// wide: octaves of every part at the ladder's wavelengths, down to `FINEST_TILES` tiles.
+fn ladder(seed: u64, ratio: f64, tile: f64) -> Vec<Entry> {
+    let mut out = Vec::new();
+    let mut ridge_total = 0.0;
+    for i in 0..LADDER_RUNGS {
+        let lambda = LADDER_TOP / DEFAULT_LACUNARITY.powi(i as i32);
+        if lambda * ratio < FINEST_TILES * tile || out.len() + 4 > MAX_ENTRIES {
+            break;
+        }
+        let mut push = |part: Part, amp: f64| {
+            let s = derive_seed(derive_seed(seed, 50 + part as u64), i as u64);
+            out.push(Entry {
+                part,
+                freq: EARTH_RADIUS / lambda,
+                offset: DVec3::new(
+                    unit_f64(mix64(s ^ 1)) * 1024.0,
+                    unit_f64(mix64(s ^ 2)) * 1024.0,
+                    unit_f64(mix64(s ^ 3)) * 1024.0,
+                ),
+                seed: s,
+                amp,
+            });
+        };
+        if lambda >= REGIONAL_MIN {
+            push(Part::Regional, REGIONAL_AMP * REGIONAL_GAIN.powi(i as i32));
+        } else {
+            push(Part::Hills, HILLS_AMP * (lambda / HILLS_REF).powf(HILLS_EXP));
+        }
+        if (RIDGE_MIN..=RIDGE_MAX).contains(&lambda) {
+            let a = RIDGE_GAIN.powf((RIDGE_MAX / lambda).ln() / DEFAULT_LACUNARITY.ln());
+            ridge_total += a;
+            push(Part::Ridge, a);
+        }
+        if lambda <= ROCK_MAX {
+            push(Part::Rocks, ROCK_AMP * (lambda / ROCK_MAX).powf(ROCK_EXP));
+        }
+    }
+    // Ridges sum to at most 1 (every signal is at most 1).
+    if ridge_total > 0.0 {
+        for e in out.iter_mut().filter(|e| e.part == Part::Ridge) {
+            e.amp /= ridge_total;
+        }
+    }
+    out
+}
+
+/// The earth density: the model behind the [`Density`] trait, with the band-limited batch.
+pub(crate) struct EarthDensity(pub Arc<EarthModel>);
+
+impl Density for EarthDensity {
+    fn density(&self, p: DVec3) -> f64 {
+        let m = &*self.0;
+        let r = p.length();
+        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let mut col = m.column(dir);
+        m.refine_for(&mut col, dir, r);
+        m.value(&col, dir, r)
+    }
+
+    fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
+        let m = &*self.0;
+        let n = dirs.len();
+        // The point call sees `|dir * r|`; the batch takes the same radius so both follow the
+        // same path (they differ only by the rounding of the direction).
+        let mut rs = vec![0.0; radii.len()];
+        for (d, dir) in dirs.iter().enumerate() {
+            let (mut r_min, mut r_max) = (f64::INFINITY, f64::NEG_INFINITY);
+            for (x, r) in rs.iter_mut().zip(radii) {
+                *x = (*dir * *r).length();
+                r_min = r_min.min(*x);
+                r_max = r_max.max(*x);
+            }
+            let mut col = m.column(*dir);
+            // Refine while some radius between the column's extremes may still need it. Refining
+            // further than a sample needs never changes its value (its stopping entry depends on
+            // the sample alone), so this cheap test is enough.
+            while col.done < m.entries.len() && col.keep_lo[col.done] < r_max && r_min < col.keep_hi[col.done] {
+                m.advance(&mut col, *dir);
+            }
+            for (k, r) in rs.iter().enumerate() {
+                out[k * n + d] = m.value(&col, *dir, *r) as f32;
+            }
+        }
+    }
+
+    fn radial_bounds(&self) -> Option<(f64, f64)> {
+        Some(self.0.bounds())
+    }
+}
+
+/// The earth shader: the seabed under water, beaches, deserts in the dry subtropics, grass and
+/// forest below a tree line, rock above it and on steep slopes, snow above a snow line that
+/// drops from about 5 km at the equator to sea level near the poles, cave rock under the
+/// surface; each material two colours mixed by noise.
+pub(crate) struct EarthShader {
+    model: Arc<EarthModel>,
+    palette: Palette,
+    jitter_seed: u64,
+    forest_seed: u64,
+    dry_seed: u64,
+}
+
+/// Snow line at the equator (true-scale metres); it falls with the square of the sine of the
+/// latitude.
+const SNOW_LINE: f64 = 5200.0;
+/// Tree line as a fraction of the snow line.
+const TREE_LINE: f64 = 0.72;
+/// Random shift of the snow and tree lines (true-scale metres).
+const LINE_JITTER: f64 = 250.0;
+
+impl EarthShader {
+    fn new(model: Arc<EarthModel>, seed: u64) -> Self {
+        let tile = model.s.tile;
+        let palette = Palette::new(
+            derive_seed(seed, 70),
+            vec![
+                Material::srgb([118, 108, 86], [92, 88, 76]),     // seabed
+                Material::srgb([222, 204, 150], [206, 178, 120]), // sand
+                Material::srgb([96, 140, 60], [128, 160, 72]),    // grass
+                Material::srgb([36, 80, 38], [56, 98, 46]),       // forest
+                Material::srgb([116, 108, 100], [148, 140, 128]), // rock
+                Material::srgb([244, 246, 252], [216, 224, 238]), // snow
+                Material::srgb([62, 56, 52], [90, 80, 72]),       // cave
+            ],
+            3.0 * tile,
+        );
+        EarthShader {
+            model,
+            palette,
+            jitter_seed: derive_seed(seed, 71),
+            forest_seed: derive_seed(seed, 72),
+            dry_seed: derive_seed(seed, 73),
+        }
+    }
+
+    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+        let m = &*self.model;
+        let (l_d, tile, v) = (m.s.l_d, m.s.tile, m.vert);
+        let r = p.length();
+        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let mut col = m.column(dir);
+        // A quarter voxel is plenty for colours: the finest octaves are left out.
+        m.refine_to(&mut col, dir, 0.25 * l_d);
+        let h = col.height();
+        if h - r > (1.5 * l_d).max(col.a_rock + col.a_cliff + l_d) {
+            return CAVE;
+        }
+        // Heights above the sea: in layout metres for the shore, in true-scale metres for the
+        // climate lines.
+        let z = r - m.sea;
+        if z < -1.5 * l_d {
+            return SEABED;
+        }
+        let up = normal.dot(dir);
+        let zt = z / v + LINE_JITTER * gradient3(p / (8.0 * tile), self.jitter_seed);
+        let lat2 = dir.y * dir.y;
+        let snow = SNOW_LINE * (1.0 - lat2).powf(1.5);
+        if zt > snow && up > 0.5 {
+            return SNOW;
+        }
+        if up < 0.68 {
+            return ROCK;
+        }
+        if z < 4.0 * v + 0.25 * l_d {
+            return SAND;
+        }
+        // Deserts: dry where a noise is high, mostly in the subtropics (sine of latitude near 0.4).
+        let subtropics = 1.0 - smoothstep(0.0, 0.25, (dir.y.abs() - 0.42).abs());
+        let dry = gradient3(dir * 3.0, self.dry_seed) + 0.35 * subtropics;
+        if dry > 0.35 && zt < 0.6 * snow {
+            return SAND;
+        }
+        if zt > TREE_LINE * snow {
+            return if col.mountains > 0.3 { ROCK } else { GRASS };
+        }
+        if lat2 > 0.78 {
+            return GRASS;
+        }
+        if gradient3(dir * m.s.freq(40.0 * tile) + DVec3::splat(0.5), self.forest_seed) + 0.2 * (0.2 - dry) > 0.0 {
+            FOREST
+        } else {
+            GRASS
+        }
+    }
+}
+
+impl Shader for EarthShader {
+    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
+        self.palette.shade(self.material(p, normal), p)
+    }
+    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
+        self.palette.shade_or_unknown(material, p)
+    }
+}
+
+/// Builds the earth terrain.
+pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
+    let model = Arc::new(EarthModel::new(seed, layout));
+    Terrain {
+        kind: PresetKind::Earth,
+        seed,
+        sea_radius: Some(model.sea()),
+        shader: Arc::new(EarthShader::new(model.clone(), seed)),
+        density: Arc::new(EarthDensity(model)),
+        materials: MATERIALS,
+        blend_colors: [[0.36, 0.48, 0.24], [0.58, 0.50, 0.36]],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::presets::testing::*;
+
+    fn earth(seed: u64) -> (Layout, Arc<EarthModel>, EarthDensity) {
+        let layout = PresetKind::Earth.default_layout(None).unwrap();
+        let m = Arc::new(EarthModel::new(seed, &layout));
+        (layout, m.clone(), EarthDensity(m))
+    }
+
+    /// The column along `dir` with every ladder entry evaluated, and its height.
+    fn full(m: &EarthModel, dir: DVec3) -> (EarthColumn, f64) {
+        let mut c = m.column(dir);
+        let h = m.full_height(&mut c, dir);
+        (c, h)
+    }
+
+    #[test]
+    fn true_scale() {
+        let (layout, m, _) = earth(1);
+        assert_eq!(m.sea(), EARTH_RADIUS);
+        assert_eq!(m.vert, 1.0);
+        assert!(
+            m.ladder_len() >= 30 && m.ladder_len() <= MAX_ENTRIES,
+            "{}",
+            m.ladder_len()
+        );
+        // The finest octave is a few metres (two tiles of about 1.2 m), the coarsest 600 km.
+        let finest = m.entries.iter().map(|e| EARTH_RADIUS / e.freq).fold(f64::MAX, f64::min);
+        assert!((2.0..6.0).contains(&finest), "finest wavelength {finest} m");
+        let (lo, hi) = m.bounds();
+        assert!(
+            lo > layout.d_b() && hi < layout.radius(),
+            "bounds {lo} {hi} leave the shell"
+        );
+        assert!(m.sea - lo > 10_000.0 && hi - m.sea > 10_000.0);
+    }
+
+    #[test]
+    fn density_is_finite_everywhere() {
+        // About two million samples: the shell at 16 m spacing, and far inside and outside it
+        // (coarse levels of detail sample layers thousands of kilometres apart).
+        let (layout, _, d) = earth(2);
+        let dirs = sphere_dirs(3000);
+        let mut radii: Vec<f64> = (0..=2048).step_by(4).map(|k| layout.layer_radius(16 * k)).collect();
+        radii.extend([0.0, 1.0, 1e3, 1e5, 1e6, 5e6, 6.2e6, 6.5e6, 7e6, 1e7, 2e7, 1e8]);
+        let mut out = vec![0.0f32; dirs.len() * radii.len()];
+        d.sample_shell(&dirs, &radii, &mut out);
+        assert!(out.len() > 1_500_000);
+        assert!(out.iter().all(|v| v.is_finite()), "a sample is not finite");
+        for p in [DVec3::ZERO, DVec3::X * 1e-300, DVec3::new(1e9, -1e9, 3.0)] {
+            assert!(d.density(p).is_finite(), "{p}");
+        }
+    }
+
+    #[test]
+    fn about_a_third_is_land() {
+        for seed in [1, 2, 3] {
+            let (_, m, _) = earth(seed);
+            let dirs = sphere_dirs(4000);
+            let land = dirs.iter().filter(|d| full(&m, **d).1 > m.sea).count() as f64 / dirs.len() as f64;
+            assert!((0.2..0.4).contains(&land), "seed {seed}: land fraction {land}");
+        }
+    }
+
+    #[test]
+    fn relief_from_trenches_to_high_mountains() {
+        let (_, m, _) = earth(1);
+        let heights: Vec<f64> = sphere_dirs(4000).iter().map(|d| full(&m, *d).1 - m.sea).collect();
+        let lowest = heights.iter().cloned().fold(f64::MAX, f64::min);
+        let highest = heights.iter().cloned().fold(f64::MIN, f64::max);
+        assert!(lowest < -6000.0, "deepest sample {lowest} m");
+        assert!(highest > 4000.0, "highest sample {highest} m");
+        assert!(lowest > -11_500.0 && highest < 9_500.0, "{lowest} .. {highest}");
+        // The ocean floor lies around -4 km, the land mostly low with hills.
+        let mut sea: Vec<f64> = heights.iter().cloned().filter(|h| *h < 0.0).collect();
+        sea.sort_by(f64::total_cmp);
+        let median_sea = sea[sea.len() / 2];
+        assert!(
+            (-5000.0..-3000.0).contains(&median_sea),
+            "median sea floor {median_sea}"
+        );
+        let mut land: Vec<f64> = heights.iter().cloned().filter(|h| *h > 0.0).collect();
+        land.sort_by(f64::total_cmp);
+        let median_land = land[land.len() / 2];
+        assert!((100.0..1500.0).contains(&median_land), "median land {median_land}");
+    }
+
+    #[test]
+    fn neighbouring_metres_differ_a_little() {
+        // Detail down to metres: columns 1.2 m apart have distinct, close surfaces; columns 30 m
+        // apart differ more (hills and rocks), and nothing quantises at 6.4e6 m.
+        let (_, m, _) = earth(3);
+        let (mut small, mut large, mut n) = (0.0, 0.0, 0.0);
+        for d in sphere_dirs(400) {
+            let (_, h) = full(&m, d);
+            if h < m.sea {
+                continue;
+            }
+            let u = d.any_orthonormal_vector();
+            let (_, h1) = full(&m, (d + u * (1.2 / m.sea)).normalize());
+            let (_, h30) = full(&m, (d + u * (30.0 / m.sea)).normalize());
+            assert_ne!(h, h1);
+            small += (h - h1).abs();
+            large += (h - h30).abs();
+            n += 1.0;
+        }
+        let (small, large) = (small / n, large / n);
+        assert!(small < 3.0 && small > 0.01, "mean step over 1.2 m: {small}");
+        assert!(large > 3.0 * small, "30 m: {large}, 1.2 m: {small}");
+    }
+
+    /// The first solid sample of the column going down from above its 3D reach in 1 m steps, and
+    /// the first air under it within `depth` metres (radii).
+    fn pocket(m: &EarthModel, d: &EarthDensity, dir: DVec3, depth: f64) -> Option<(f64, Option<f64>)> {
+        let (c, h) = full(m, dir);
+        let top = (h + c.w_up).ceil();
+        let n = (c.w_up + c.w_down + depth).ceil() as usize + 2;
+        let radii: Vec<f64> = (0..n).map(|i| top - i as f64).collect();
+        let mut out = vec![0.0f32; n];
+        d.sample_shell(&[dir], &radii, &mut out);
+        let first = out.iter().position(|v| *v > 0.0)?;
+        let surface = radii[first];
+        let air = (first..n)
+            .take_while(|i| radii[*i] >= surface - depth)
+            .find(|i| out[*i] <= 0.0)
+            .map(|i| radii[i]);
+        Some((surface, air))
+    }
+
+    #[test]
+    fn caves_under_the_land_within_reach() {
+        let (_, m, d) = earth(1);
+        let (mut land, mut with_air) = (0, 0);
+        for dir in sphere_dirs(20_000) {
+            let Some((surface, air)) = pocket(&m, &d, dir, 50.0) else {
+                continue;
+            };
+            if surface <= m.sea {
+                continue;
+            }
+            land += 1;
+            if let Some(r) = air {
+                assert!(r > m.sea, "a dry cave under the sea at {}", r - m.sea);
+                with_air += 1;
+            }
+            if land == 2000 {
+                break;
+            }
+        }
+        assert_eq!(land, 2000);
+        let frac = f64::from(with_air) / f64::from(land);
+        assert!(
+            frac >= 0.05,
+            "land columns with air within 50 m under the surface: {frac}"
+        );
+        assert!(frac < 0.6, "too hollow: {frac}");
+    }
+
+    #[test]
+    fn caves_and_overhangs_stay_near_the_surface() {
+        // Nothing hollow deeper than the 3D reach under the surface, nothing solid above it.
+        let (_, m, d) = earth(4);
+        for dir in sphere_dirs(1500) {
+            let (c, h) = full(&m, dir);
+            assert!(c.w_down <= 72.0 && c.w_up <= 18.0, "reach {} {}", c.w_down, c.w_up);
+            for z in [c.w_down + 0.01, 100.0, 1000.0] {
+                assert!(d.density(dir * (h - z)) > 0.0, "air {z} m under the surface");
+                assert!(
+                    d.density(dir * (h + z.max(c.w_up + 0.01))) <= 0.0,
+                    "solid above the surface"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn overhangs_fold_the_surface_in_the_mountains() {
+        let (_, m, d) = earth(1);
+        let mut folded = 0;
+        for dir in sphere_dirs(40_000) {
+            let (c, h) = full(&m, dir);
+            if c.a_cliff < 4.0 {
+                continue;
+            }
+            // Look within the displacement only, above any cave band.
+            if sign_changes(&d, dir, h - 1.5 * c.a_cliff - 1.0, h + c.w_up, 0.25) > 1 {
+                folded += 1;
+            }
+        }
+        assert!(folded > 5, "folded columns: {folded}");
+    }
+
+    #[test]
+    fn behaves_like_a_signed_distance() {
+        // Away from the 3D band the density is the radial distance to the surface within 1/8
+        // (exactly h - r when every octave was needed), with its sign; in the band it differs
+        // from h - r by less than the band.
+        let (_, m, d) = earth(5);
+        let zs = [
+            -10_000.0, -3000.0, -1000.0, -300.0, -100.0, -30.0, -10.0, -3.0, -1.0, -0.3, 0.4, 1.5, 4.0, 12.0, 40.0,
+            90.0, 200.0, 1000.0, 4000.0, 10_000.0,
+        ];
+        for dir in sphere_dirs(600) {
+            let (c, h) = full(&m, dir);
+            let band = c.w_down.max(c.w_up);
+            for z in zs {
+                let v = d.density(dir * (h - z));
+                let outside = z > c.w_down || -z > c.w_up;
+                if outside {
+                    assert_eq!(v > 0.0, z > 0.0, "sign at {z} m");
+                    assert!((v - z).abs() <= z.abs() / STOP_FACTOR + 1e-6, "{v} at {z} m");
+                } else {
+                    assert!((v - z).abs() <= band, "{v} at {z} m in a band of {band}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn shortcuts_agree_with_the_full_formula() {
+        // In the band around the surface the value is the full formula bit for bit; elsewhere
+        // it is within 1/8 of it, with the same sign.
+        let (_, m, d) = earth(6);
+        let mut exact = 0;
+        for dir in sphere_dirs(300) {
+            let (c, h) = full(&m, dir);
+            let radii: Vec<f64> = (-80..=40)
+                .map(|i| h + 0.73 * f64::from(i))
+                .chain([h - 5e3, h + 5e3])
+                .collect();
+            let mut out = vec![0.0f32; radii.len()];
+            d.sample_shell(&[dir], &radii, &mut out);
+            for (r, v) in radii.iter().zip(&out) {
+                let full = m.reference(dir, *r);
+                if h - r < c.w_down && r - h < c.w_up {
+                    assert_eq!(v.to_bits(), (full as f32).to_bits(), "at {} m", h - r);
+                    exact += 1;
+                } else {
+                    assert_eq!(*v > 0.0, full > 0.0);
+                    assert!((f64::from(*v) - full).abs() <= full.abs() / STOP_FACTOR + 1e-3);
+                }
+            }
+        }
+        assert!(exact > 5000, "{exact}");
+    }
+
+    #[test]
+    fn a_voxel_has_one_value_whatever_batch_holds_it() {
+        // Chunks share border layers and columns: the band-limiting must not depend on the
+        // batch. Two overlapping radius sets at several scales give the same bits where they meet.
+        let (_, m, d) = earth(7);
+        let dirs: Vec<DVec3> = sphere_dirs(200)
+            .into_iter()
+            .flat_map(|c| {
+                let u = c.any_orthonormal_vector();
+                [c, (c + u * (1.0 / m.sea)).normalize()]
+            })
+            .collect();
+        for dir in &dirs {
+            let (_, h) = full(&m, *dir);
+            for step in [1.0, 16.0, 1024.0, 65_536.0] {
+                let r0 = (h / step).floor() * step;
+                let a: Vec<f64> = (-34..=0).map(|i| r0 + step * f64::from(i)).collect();
+                let b: Vec<f64> = (0..=34).map(|i| r0 + step * f64::from(i)).collect();
+                let (mut va, mut vb) = (vec![0.0f32; 35], vec![0.0f32; 35]);
+                d.sample_shell(&[*dir], &a, &mut va);
+                d.sample_shell(&[*dir], &b, &mut vb);
+                assert_eq!(va[34].to_bits(), vb[0].to_bits(), "step {step}");
+                let mut one = [0.0f32];
+                d.sample_shell(&[*dir], &[r0], &mut one);
+                assert_eq!(one[0].to_bits(), vb[0].to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn batch_matches_points_and_is_deterministic() {
+        let (_, m, d) = earth(7);
+        let centre = sphere_dirs(4000)
+            .into_iter()
+            .find(|dir| {
+                let (c, h) = full(&m, *dir);
+                c.cave_gate > 0.5 && h > m.sea + 100.0
+            })
+            .expect("land with caves");
+        let (_, h) = full(&m, centre);
+        let patch = patch(centre, 1.2, 12, h - 40.0, 1.0, 50);
+        check_batch_matches_points(&d, &patch, 1e-3);
+        // And far from the surface, at coarse strides.
+        let coarse = super::super::testing::patch(centre, 5000.0, 6, h - 8000.0, 1000.0, 17);
+        check_batch_matches_points(&d, &coarse, 1e-3);
+    }
+
+    #[test]
+    fn surface_within_bounds_at_true_scale() {
+        // Sparser than the shared check (the shell is 32 768 voxels deep).
+        let (layout, _, d) = earth(3);
+        let (lo, hi) = d.radial_bounds().unwrap();
+        let radii: Vec<f64> = (0..=1024).map(|k| layout.layer_radius(32 * k)).collect();
+        let dirs = sphere_dirs(1000);
+        let mut out = vec![0.0f32; dirs.len() * radii.len()];
+        d.sample_shell(&dirs, &radii, &mut out);
+        for (k, r) in radii.iter().enumerate() {
+            for v in &out[k * dirs.len()..(k + 1) * dirs.len()] {
+                if *r < lo {
+                    assert!(*v > 0.0, "air below the lower bound at {r}");
+                }
+                if *r > hi {
+                    assert!(*v <= 0.0, "solid above the upper bound at {r}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn works_on_small_layouts() {
+        for layout in [
+            Layout::default(),
+            Layout::new(2, 8, 200.0, 2.0, 1).unwrap(),
+            PresetKind::Earth.default_layout(Some(20_000.0)).unwrap(),
+        ] {
+            let t = build(3, &layout);
+            check_surface_within_bounds(&t, &layout);
+            let other = build(4, &layout);
+            check_seeds_differ(&*t.density, &*other.density, &layout);
+            assert_eq!(
+                t.sea_radius,
+                Some(layout.d_b() + 0.5 * layout.l_d() * layout.depth_tiles() as f64)
+            );
+        }
+    }
+
+    #[test]
+    fn same_planet_at_every_scale() {
+        // Shrunk onto the default layout, the continents are where they are at true scale.
+        let (_, big, _) = earth(5);
+        let small = EarthModel::new(5, &Layout::default());
+        let dirs = sphere_dirs(2000);
+        let agree = dirs
+            .iter()
+            .filter(|d| (full(&big, **d).1 > big.sea) == (full(&small, **d).1 > small.sea))
+            .count();
+        assert!(agree * 100 > dirs.len() * 90, "{agree} of {}", dirs.len());
+    }
+
+    #[test]
+    fn golden_values() {
+        // A fixed seed gives fixed bits. Direction 24 is a coastal lowland (30 m) with caves, so
+        // its radii 10 to 31 m above the sea cross the 3D band; the others are far from it.
+        let (_, _, d) = earth(7);
+        let all = sphere_dirs(40);
+        let dirs = [all[24], all[3], all[11], all[0]];
+        let radii = [-3000.0, 10.0, 25.0, 29.0, 31.0, 80.0, 4e5].map(|z| EARTH_RADIUS + z);
+        let mut out = vec![0.0f32; dirs.len() * radii.len()];
+        d.sample_shell(&dirs, &radii, &mut out);
+        let bits: Vec<u32> = out.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(bits, GOLDEN, "values now: {out:?}");
+        for (i, dir) in dirs.iter().enumerate() {
+            assert_eq!((d.density(*dir * radii[6]) as f32).to_bits(), GOLDEN[6 * 4 + i]);
+        }
+    }
+
+    const GOLDEN: [u32; 28] = [
+        1161558163, 1162496898, 1163982681, 3291377753, 1100993642, 1132375983, 1141563578, 3311600104, 1084182953,
+        1131392943, 1141317818, 3311661544, 1063810274, 1131130799, 1141252282, 3311677928, 3213362494, 1130999727,
+        1141219514, 3311686120, 3259692377, 1127700414, 1139982708, 3311886824, 3368242866, 3368234533, 3368230208,
+        3368363998,
+    ];
+
+    #[test]
+    fn shader_tells_the_seabed_the_beach_and_the_peaks_apart() {
+        let (_, m, _) = earth(1);
+        let t = build(1, &PresetKind::Earth.default_layout(None).unwrap());
+        let mat = |p: DVec3, n: DVec3| MATERIALS[usize::from(t.shader.shade(p, n).material)];
+        let (mut beach, mut seabed, mut peak) = (None, None, None::<(f64, DVec3)>);
+        for dir in sphere_dirs(40_000) {
+            let (_, h) = full(&m, dir);
+            let z = h - m.sea;
+            if z > 0.3 && z < 2.0 && beach.is_none() {
+                beach = Some(dir * h);
+            }
+            if z < -3000.0 && seabed.is_none() {
+                seabed = Some(dir * h);
+            }
+            if dir.y.abs() < 0.5 && peak.is_none_or(|(best, _)| z > best) {
+                peak = Some((z, dir * h));
+            }
+        }
+        let beach = beach.expect("a beach");
+        assert_eq!(mat(beach, beach.normalize()), "sand");
+        let seabed = seabed.expect("deep sea");
+        assert_eq!(mat(seabed, seabed.normalize()), "seabed");
+        let (z, peak) = peak.unwrap();
+        assert!(z > 5500.0, "highest tropical peak {z}");
+        assert_eq!(mat(peak, peak.normalize()), "snow");
+        // A cliff is rock, deep underground is cave rock.
+        let side = peak.normalize().any_orthonormal_vector();
+        assert_eq!(mat(peak, side), "rock");
+        assert_eq!(mat(peak * (1.0 - 40.0 / peak.length()), peak.normalize()), "cave");
+        // Grass and forest both occur on the lowlands.
+        let mut seen = std::collections::HashSet::new();
+        for dir in sphere_dirs(6000) {
+            let (_, h) = full(&m, dir);
+            if h > m.sea + 50.0 {
+                seen.insert(mat(dir * h, dir));
+            }
+        }
+        for name in ["grass", "forest", "rock", "sand", "snow"] {
+            assert!(seen.contains(name), "no {name} on the land: {seen:?}");
+        }
+    }
+}
