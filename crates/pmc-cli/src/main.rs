@@ -3,6 +3,7 @@
 
 mod edit;
 mod error;
+mod flight;
 mod generate;
 mod info;
 mod path;
@@ -36,6 +37,9 @@ enum Command {
     Edit(edit::EditArgs),
     /// Find a walking path between two places over the navigation grid (JSON or GeoJSON).
     Path(path::PathArgs),
+    /// Measure a viewer's flight through an in-process server: a cold teleport to 2 m above
+    /// the ground, then a descent from orbit (time to converge, triangles, memory per stop).
+    BenchFlight(flight::FlightArgs),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         }
         Command::Edit(a) => edit::run(a),
         Command::Path(a) => path::run(a),
+        Command::BenchFlight(a) => flight::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -113,3 +113,27 @@ fn a_planet_too_large_to_mesh_whole_points_to_regions() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(triangles(&o) > 0);
 }
+
+#[test]
+fn bench_flight_reports_every_stop_as_json() {
+    let o = pmc(&["bench-flight", "--n-c", "4", "--n-t", "8", "--at", "-10,40", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let flights = v.as_array().unwrap();
+    assert_eq!(flights.len(), 2);
+    let stops: Vec<&str> = flights[1]["stops"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(stops, ["orbit", "10 km", "100 m", "2 m"]);
+    for f in flights {
+        for s in f["stops"].as_array().unwrap() {
+            assert!(s["triangles"].as_u64().unwrap() > 0, "{s}");
+            assert!(s["converged_s"].as_f64().unwrap() >= 0.0);
+        }
+    }
+    let bad = pmc(&["bench-flight", "--at", "100,0"]);
+    assert!(!bad.status.success() && stderr(&bad).contains("--at"));
+}

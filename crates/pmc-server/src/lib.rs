@@ -30,6 +30,7 @@ mod config;
 pub mod edit_api;
 mod editing;
 mod error;
+pub mod flight;
 mod generator;
 mod lru;
 pub mod nav_api;

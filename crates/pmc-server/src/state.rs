@@ -218,6 +218,19 @@ impl AppState {
 
     /// The planet `id` and its edit revision (0 for planets that are not edited), built (off the
     /// async runtime) when it is not held.
+    /// [`AppState::lod_errors`] of the default planet.
+    pub async fn lod_errors_of_default(&self) -> Result<Arc<Vec<f64>>, String> {
+        let c = self.config();
+        let planet = self.default_planet().await?;
+        Ok(self.lod_errors((c.preset, c.seed), planet).await)
+    }
+
+    /// The server's default planet (the world's, with its edits, when serving a world).
+    pub async fn default_planet(&self) -> Result<Arc<Planet>, String> {
+        let c = self.config();
+        self.planet((c.preset, c.seed)).await.map(|(p, _)| p)
+    }
+
     pub(crate) async fn planet(&self, id: PlanetId) -> Result<(Arc<Planet>, u64), String> {
         if let Some(e) = self.editing_of(id) {
             let c = e.current();

@@ -1,0 +1,343 @@
+//! A flight benchmark through the server: a viewer's teleports, measured.
+//!
+//! For each stop of a flight (an eye and a point to look at), the level-of-detail selection of
+//! [`pmc_lod`] is run for that view with the planet's measured level errors (as the viewer
+//! does), every drawn chunk is requested from the server through its HTTP router with its
+//! `seams` mask, a bounded number at a time (as a viewer does), and the stop is *converged* when
+//! every one of them has answered. Reported per stop: the time to converge from the moment the
+//! camera arrives, chunks and triangles drawn, chunks generated per second per level, the
+//! process's peak memory, and the triangles a level-0-only mesh of the same chunks would have
+//! (estimated as `4^L` times each level-`L` chunk's triangles: each level halves the cell size
+//! along the surface).
+//!
+//! The requests go through [`crate::router`] in process (no socket), so the figures are the
+//! server's: routing, the job queue, generation on the worker pool, encoding and the cache.
+
+use crate::AppState;
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use futures_util::StreamExt;
+use pmc_geometry::glam::DVec3;
+use pmc_lod::{frustum_planes, LodParams, Selector, View};
+use std::time::{Duration, Instant};
+use tower::ServiceExt;
+
+/// One stop of a flight.
+#[derive(Clone, Debug)]
+pub struct Stop {
+    /// A name for the report (e.g. "orbit", "2 m").
+    pub name: String,
+    /// The eye, planet frame, metres.
+    pub eye: DVec3,
+    /// The point looked at, planet frame, metres.
+    pub look_at: DVec3,
+    /// The eye's height above the ground below it, metres.
+    pub height: f64,
+}
+
+/// The camera and the selection's settings for every stop.
+#[derive(Clone, Copy, Debug)]
+pub struct FlightCamera {
+    /// Vertical field of view, radians.
+    pub fov_y: f64,
+    /// Viewport width over height.
+    pub aspect: f64,
+    /// Viewport height, pixels.
+    pub viewport_height_px: f64,
+    /// Largest screen-space error, pixels.
+    pub max_pixel_error: f64,
+    /// Most chunks a selection may hold.
+    pub max_chunks: usize,
+    /// Chunk requests in flight at once.
+    pub concurrency: usize,
+}
+
+impl Default for FlightCamera {
+    /// 60° field of view, 1920 × 1080, 2 px, 4096 chunks, 16 requests in flight.
+    fn default() -> Self {
+        FlightCamera {
+            fov_y: 60f64.to_radians(),
+            aspect: 16.0 / 9.0,
+            viewport_height_px: 1080.0,
+            max_pixel_error: 2.0,
+            max_chunks: pmc_lod::DEFAULT_MAX_CHUNKS,
+            concurrency: 16,
+        }
+    }
+}
+
+/// What one stop measured.
+#[derive(Clone, Debug)]
+pub struct StopReport {
+    /// The stop's name.
+    pub name: String,
+    /// The eye's height above the ground below it, metres.
+    pub height: f64,
+    /// Time from the camera's arrival (selection included) to every drawn chunk answered.
+    pub converged: Duration,
+    /// Time the selection took.
+    pub selection: Duration,
+    /// Chunks selected (drawn or culled) and drawn.
+    pub selected: usize,
+    /// Drawn chunks per level (index = level).
+    pub drawn_per_level: Vec<usize>,
+    /// Triangles of the drawn chunks.
+    pub triangles: u64,
+    /// Estimated triangles of a level-0-only mesh of the same chunks.
+    pub level0_triangles: f64,
+    /// Chunks generated per second per level during the stop (chunks answered from the cache
+    /// not counted), `None` for levels with none.
+    pub chunks_per_second: Vec<Option<f64>>,
+    /// Whether the selection hit its chunk budget.
+    pub truncated: bool,
+    /// Requests answered 503 (queue full) and retried.
+    pub retries: u64,
+    /// The process's peak resident memory so far, bytes (`VmHWM`), when the system tells.
+    pub peak_rss: Option<u64>,
+}
+
+/// Why a flight failed.
+#[derive(Debug, thiserror::Error)]
+pub enum FlightError {
+    /// The selection refused its input.
+    #[error("level-of-detail selection: {0}")]
+    Selection(#[from] pmc_lod::LodError),
+    /// The server answered a chunk request with an error.
+    #[error("chunk {path}: the server answered {status}: {body}")]
+    Chunk {
+        /// The request path.
+        path: String,
+        /// The status.
+        status: StatusCode,
+        /// The answer's text.
+        body: String,
+    },
+    /// A chunk could not be decoded.
+    #[error("chunk {path}: {reason}")]
+    Decode {
+        /// The request path.
+        path: String,
+        /// What was wrong.
+        reason: String,
+    },
+}
+
+/// The radius of the outermost surface above `dir` (a unit vector) on the served planet, by
+/// stepping down from the top of the shell and bisecting the first crossing; `None` when the
+/// column holds no surface.
+pub fn surface_radius(planet: &pmc_planet::Planet, dir: DVec3) -> Option<f64> {
+    let density = planet.density();
+    let layout = planet.layout();
+    let (top, bottom) = match density.radial_bounds() {
+        Some((lo, hi)) => (hi.min(layout.radius()), lo.max(layout.d_b())),
+        None => (layout.radius(), layout.d_b()),
+    };
+    let step = layout.l_d().max((top - bottom) / 4096.0);
+    let mut hi = top;
+    let solid = |r: f64| density.density(dir * r) > 0.0;
+    if solid(hi) {
+        return Some(hi);
+    }
+    let mut lo = hi - step;
+    while lo >= bottom {
+        if solid(lo) {
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if solid(mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return Some(lo);
+        }
+        hi = lo;
+        lo -= step;
+    }
+    None
+}
+
+/// The process's peak resident memory (`VmHWM` of `/proc/self/status`), bytes.
+pub fn peak_rss() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Flies through `stops` on the server's default planet, one after the other without clearing
+/// the cache (as a user flying down would), and measures each.
+pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Result<Vec<StopReport>, FlightError> {
+    let id = (state.config().preset, state.config().seed);
+    let planet = state.default_planet().await.map_err(|reason| FlightError::Decode {
+        path: "/api/v1/planet".into(),
+        reason,
+    })?;
+    let errors = state.lod_errors(id, planet.clone()).await;
+    let selector = Selector::new(*planet.layout(), errors.to_vec(), pmc_lod::occluder_radius(&planet))?;
+    let router = crate::router(state.clone());
+    let datum = planet.datum_radius();
+    let mut reports = Vec::with_capacity(stops.len());
+    for stop in stops {
+        let start = Instant::now();
+        let forward = stop.look_at - stop.eye;
+        let up = stop.eye.normalize_or(DVec3::Y);
+        let up = if forward.cross(up).length_squared() < 1e-12 * forward.length_squared() {
+            DVec3::Y
+        } else {
+            up
+        };
+        let altitude = stop.eye.length() - datum;
+        let near = (0.5 * altitude.abs().min(stop.height.abs())).clamp(0.05, 1.0e5);
+        let far = stop.eye.length() + planet.layout().radius() * 2.0;
+        let view = View {
+            eye: stop.eye,
+            frustum: Some(frustum_planes(
+                stop.eye,
+                forward,
+                up,
+                camera.fov_y,
+                camera.aspect,
+                near,
+                far,
+            )),
+            viewport_height_px: camera.viewport_height_px,
+            fov_y: camera.fov_y,
+        };
+        let params = LodParams {
+            max_pixel_error: camera.max_pixel_error,
+            max_chunks: camera.max_chunks,
+            ..LodParams::default()
+        };
+        let selection = selector.select(&view, &params)?;
+        let selection_time = start.elapsed();
+        let levels = usize::from(planet.layout().max_level()) + 1;
+        let drawn: Vec<_> = selection.chunks.iter().filter(|s| s.drawn).copied().collect();
+        let before = state.stats();
+        let results = futures_util::stream::iter(drawn.iter().map(|s| {
+            let router = router.clone();
+            let k = s.key;
+            let path = format!(
+                "/api/v1/chunk/{}/{}/{}/{}/{}?seams={}",
+                k.face.name(),
+                k.level,
+                k.i,
+                k.j,
+                k.k,
+                s.coarser.0
+            );
+            async move {
+                fetch(router, path)
+                    .await
+                    .map(|(tris, retries)| (k.level, tris, retries))
+            }
+        }))
+        .buffer_unordered(camera.concurrency.max(1))
+        .collect::<Vec<_>>()
+        .await;
+        let converged = start.elapsed();
+        let after = state.stats();
+        let mut drawn_per_level = vec![0usize; levels];
+        let (mut triangles, mut level0, mut retries) = (0u64, 0f64, 0u64);
+        for r in results {
+            let (level, tris, tries) = r?;
+            drawn_per_level[usize::from(level)] += 1;
+            triangles += tris;
+            level0 += tris as f64 * 4f64.powi(i32::from(level));
+            retries += tries;
+        }
+        // Chunks generated during the stop, by level: the drawn chunks not answered from the
+        // cache. The generator counts jobs in total; attribute them to levels in proportion.
+        let generated = after.generated.saturating_sub(before.generated);
+        let drawn_total = drawn.len().max(1) as f64;
+        let seconds = (converged - selection_time).as_secs_f64().max(1e-9);
+        let chunks_per_second = drawn_per_level
+            .iter()
+            .map(|n| (*n > 0 && generated > 0).then(|| generated as f64 * (*n as f64 / drawn_total) / seconds))
+            .collect();
+        reports.push(StopReport {
+            name: stop.name.clone(),
+            height: stop.height,
+            converged,
+            selection: selection_time,
+            selected: selection.chunks.len(),
+            drawn_per_level,
+            triangles,
+            level0_triangles: level0,
+            chunks_per_second,
+            truncated: selection.truncated,
+            retries,
+            peak_rss: peak_rss(),
+        });
+    }
+    Ok(reports)
+}
+
+/// Requests one chunk until it is answered (retrying 503s after a short pause) and returns its
+/// triangle count and the number of retries.
+async fn fetch(router: axum::Router, path: String) -> Result<(u64, u64), FlightError> {
+    let mut retries = 0;
+    loop {
+        let req = Request::get(&path).body(Body::empty()).expect("a valid request");
+        let resp = router.clone().oneshot(req).await.expect("the router is infallible");
+        let status = resp.status();
+        let bytes = axum::body::to_bytes(resp.into_body(), usize::MAX)
+            .await
+            .map_err(|e| FlightError::Decode {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
+        if status == StatusCode::SERVICE_UNAVAILABLE {
+            retries += 1;
+            tokio::time::sleep(Duration::from_millis(5)).await;
+            continue;
+        }
+        if status != StatusCode::OK {
+            return Err(FlightError::Chunk {
+                path,
+                status,
+                body: String::from_utf8_lossy(&bytes).into_owned(),
+            });
+        }
+        let chunk = pmc_formats::chunk_encoding::decode_chunk(&bytes).map_err(|e| FlightError::Decode {
+            path: path.clone(),
+            reason: e.to_string(),
+        })?;
+        return Ok(((chunk.indices.len() / 3) as u64, retries));
+    }
+}
+
+/// The stops of a descent over `lat`, `lon` (degrees) at the given heights above the ground
+/// (metres; the ground is the surface under the point, or the datum where the column holds
+/// none): from high up the camera looks at the planet's centre, from low down at the ground
+/// ahead, 15° below the horizon, facing north (east at the poles).
+pub fn descent(
+    planet: &pmc_planet::Planet,
+    lat: f64,
+    lon: f64,
+    heights: &[(String, f64)],
+) -> Result<Vec<Stop>, String> {
+    let dir = pmc_geometry::LatLon::new(lat, lon)
+        .map_err(|e| e.to_string())?
+        .to_unit();
+    let ground = surface_radius(planet, dir).unwrap_or_else(|| planet.datum_radius());
+    let north = (DVec3::Y - dir * dir.y).normalize_or(DVec3::X);
+    Ok(heights
+        .iter()
+        .map(|(name, h)| {
+            let eye = dir * (ground + h);
+            let look_at = if *h > 0.1 * planet.layout().radius() {
+                DVec3::ZERO
+            } else {
+                let ahead = north * 15f64.to_radians().cos() - dir * 15f64.to_radians().sin();
+                eye + ahead * h.max(1.0) * 10.0
+            };
+            Stop {
+                name: name.clone(),
+                eye,
+                look_at,
+                height: *h,
+            }
+        })
+        .collect())
+}
