@@ -4,7 +4,6 @@
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
 use clap::{Args, Parser, ValueEnum};
-use pmc_density::Density;
 use pmc_edit::{BrushKind, BrushOp};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{LatLon, Layout};
@@ -235,43 +234,6 @@ pub(crate) fn parse_place(opt: &str, s: &str) -> Result<At, CliError> {
     Ok(At { lat, lon, alt })
 }
 
-/// The radius of the first surface (of the edited planet) met going down the ray `dir` from the
-/// top of the shell: the
-/// density is sampled every quarter tile (`l_d / 4`) and the first sign change refined by
-/// bisection. The shell contract makes the base solid, so the answer is at least `d_b`.
-fn surface_radius(planet: &Planet, dir: DVec3) -> f64 {
-    let l = planet.layout();
-    let density = planet.density();
-    let solid = |r: f64| density.density(dir * r) > 0.0;
-    let (top, bottom) = (l.radius(), l.d_b());
-    if solid(top) {
-        return top;
-    }
-    let step = l.l_d() / 4.0;
-    let mut above = top;
-    let steps = ((top - bottom) / step).ceil() as u64;
-    for i in 1..=steps {
-        let r = (top - i as f64 * step).max(bottom);
-        if solid(r) {
-            let (mut lo, mut hi) = (r, above);
-            for _ in 0..64 {
-                let mid = 0.5 * (lo + hi);
-                if mid <= lo || mid >= hi {
-                    break;
-                }
-                if solid(mid) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            return 0.5 * (lo + hi);
-        }
-        above = r;
-    }
-    bottom
-}
-
 /// The centre of edit `k` of a `--repeat` run.
 fn center(planet: &Planet, at: At, k: u64) -> Result<DVec3, CliError> {
     let lon = at.lon + k as f64 * REPEAT_LON_STEP;
@@ -280,7 +242,7 @@ fn center(planet: &Planet, at: At, k: u64) -> Result<DVec3, CliError> {
         .to_unit();
     let r = match at.alt {
         Some(alt) => planet.datum_radius() + alt,
-        None => surface_radius(planet, dir),
+        None => planet.surface_radius(dir),
     };
     if r <= 0.0 {
         return Err(CliError::Edit(format!(
@@ -585,7 +547,7 @@ mod tests {
         let planet = Planet::new(PresetKind::Sphere, 1, layout);
         let density = &planet.terrain().density;
         for dir in [DVec3::Y, DVec3::new(1.0, -2.0, 0.5).normalize()] {
-            let r = surface_radius(&planet, dir);
+            let r = planet.surface_radius(dir);
             assert!(density.density(dir * (r - 1e-6)) > 0.0, "solid just below {r}");
             assert!(density.density(dir * (r + 1e-6)) <= 0.0, "air just above {r}");
         }

@@ -27,7 +27,7 @@ pub struct GenerateArgs {
     world: Option<PathBuf>,
 
     /// Export only a region: the chunks of one level of detail within RADIUS_M metres of the
-    /// surface point at LAT,LON (degrees). For planets too large to mesh whole (Earth). The
+    /// ground at LAT,LON (degrees; the first surface going down from the sky). For planets too large to mesh whole (Earth). The
     /// level is --level, or the coarsest whose measured error is within --max-error, or 0.
     #[arg(long, value_name = "LAT,LON,RADIUS_M", allow_hyphen_values = true)]
     region: Option<String>,
@@ -115,10 +115,11 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
                 }
                 (None, None) => 0,
             };
-            let centre = LatLon::new(lat, lon)
+            let dir = LatLon::new(lat, lon)
                 .map_err(|e| CliError::Region(e.to_string()))?
-                .to_unit()
-                * planet.datum_radius();
+                .to_unit();
+            // Centred on the ground there, so the region holds the surface around the place.
+            let centre = dir * planet.surface_radius(dir);
             let keys = pmc_lod::region_chunks(&planet, centre, radius, level, REGION_BUDGET)
                 .map_err(|e| CliError::Region(e.to_string()))?;
             if !args.quiet {

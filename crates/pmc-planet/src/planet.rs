@@ -244,6 +244,47 @@ impl Planet {
             .unwrap_or_else(|| 0.5 * (self.layout.d_b() + self.layout.radius()))
     }
 
+    /// The radius of the first surface (of the edited planet) met going down the ray `dir` (a
+    /// unit vector) from the top of the shell: the density is sampled every quarter tile
+    /// (`l_d / 4`) from the highest radius the surface can reach (the density's radial bounds,
+    /// or the shell's top), and the first sign change is refined by bisection. The shell contract
+    /// makes the base solid, so the answer is at least `d_b`.
+    pub fn surface_radius(&self, dir: DVec3) -> f64 {
+        let l = self.layout();
+        let density = self.density();
+        let solid = |r: f64| density.density(dir * r) > 0.0;
+        let (top, bottom) = match density.radial_bounds() {
+            Some((lo, hi)) if lo.is_finite() && hi.is_finite() => (hi.min(l.radius()).max(l.d_b()), lo.max(l.d_b())),
+            _ => (l.radius(), l.d_b()),
+        };
+        if solid(top) {
+            return top;
+        }
+        let step = l.l_d() / 4.0;
+        let mut above = top;
+        let steps = ((top - bottom) / step).ceil() as u64;
+        for i in 1..=steps {
+            let r = (top - i as f64 * step).max(bottom);
+            if solid(r) {
+                let (mut lo, mut hi) = (r, above);
+                for _ in 0..64 {
+                    let mid = 0.5 * (lo + hi);
+                    if mid <= lo || mid >= hi {
+                        break;
+                    }
+                    if solid(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                return 0.5 * (lo + hi);
+            }
+            above = r;
+        }
+        bottom
+    }
+
     /// Whether a chunk may hold surface, judged from the (edited) density's radial bounds and the
     /// shell boundary contract alone (no sampling).
     pub fn may_hold_surface(&self, key: &ChunkKey) -> bool {

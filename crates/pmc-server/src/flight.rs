@@ -122,41 +122,6 @@ pub enum FlightError {
     },
 }
 
-/// The radius of the outermost surface above `dir` (a unit vector) on the served planet, by
-/// stepping down from the top of the shell and bisecting the first crossing; `None` when the
-/// column holds no surface.
-pub fn surface_radius(planet: &pmc_planet::Planet, dir: DVec3) -> Option<f64> {
-    let density = planet.density();
-    let layout = planet.layout();
-    let (top, bottom) = match density.radial_bounds() {
-        Some((lo, hi)) => (hi.min(layout.radius()), lo.max(layout.d_b())),
-        None => (layout.radius(), layout.d_b()),
-    };
-    let step = layout.l_d().max((top - bottom) / 4096.0);
-    let mut hi = top;
-    let solid = |r: f64| density.density(dir * r) > 0.0;
-    if solid(hi) {
-        return Some(hi);
-    }
-    let mut lo = hi - step;
-    while lo >= bottom {
-        if solid(lo) {
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if solid(mid) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            return Some(lo);
-        }
-        hi = lo;
-        lo -= step;
-    }
-    None
-}
-
 /// The process's peak resident memory (`VmHWM` of `/proc/self/status`), bytes.
 pub fn peak_rss() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -320,7 +285,7 @@ pub fn descent(
     let dir = pmc_geometry::LatLon::new(lat, lon)
         .map_err(|e| e.to_string())?
         .to_unit();
-    let ground = surface_radius(planet, dir).unwrap_or_else(|| planet.datum_radius());
+    let ground = planet.surface_radius(dir);
     let north = (DVec3::Y - dir * dir.y).normalize_or(DVec3::X);
     Ok(heights
         .iter()
