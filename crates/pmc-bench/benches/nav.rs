@@ -2,12 +2,22 @@
 //! agent: building the whole grid, rebuilding one tile (the columns under one chunk footprint,
 //! through the whole depth, with the components relabelled), rebuilding after a 4 m and a 16 m
 //! remove brush, and A* from corner to corner of a face and over a shorter walk.
+//!
+//! `nav_lazy`: the lazy grid on the Earth at true scale (the earth preset on its own layout, seed
+//! 7: 1 m layers, 6 x 8 388 608^2 columns), from a cold cache, tiles built and searched on the
+//! calling thread, default agent and search options (4-column tiles, weight 1.5): between two
+//! places 10 km apart on land, east of each other and north-east (across the grid's diagonal),
+//! the first also with chunk-footprint tiles for comparison; and 500 m.
 use criterion::{criterion_group, criterion_main, Criterion};
 use pmc_bench::{default_planet, nearest_column, surface_along, surface_point};
+use pmc_density::presets::{build, PresetKind};
+use pmc_density::Density;
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
-use pmc_nav::{find_path, Agent, NavGrid};
+use pmc_geometry::{LatLon, Layout};
+use pmc_nav::{find_path, Agent, End, LazyGrid, LazyOptions, NavGrid, PathAnswer, SearchOptions};
 use std::hint::black_box;
+use std::sync::Arc;
 use std::time::Duration;
 
 fn nav(c: &mut Criterion) {
@@ -73,5 +83,90 @@ fn nav(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, nav);
+/// The place `north` and `east` metres from (`lat`, `lon`).
+fn offset(lat: f64, lon: f64, north: f64, east: f64) -> End {
+    const R: f64 = 6_371_000.0;
+    End {
+        dir: LatLon {
+            lat: lat + (north / R).to_degrees(),
+            lon: lon + (east / (R * lat.to_radians().cos())).to_degrees(),
+        }
+        .to_unit(),
+        radius: None,
+    }
+}
+
+/// The first place of a coarse scan whose ground, and the ground `north` and `east` metres from
+/// it, lie at least 100 m above the sea.
+fn land(d: &Arc<dyn Density>, layout: &Layout, sea: f64, (north, east): (f64, f64)) -> (End, End) {
+    let mut g = LazyGrid::new(d.clone(), layout, Agent::default(), LazyOptions::default()).expect("a grid");
+    let mut high = |e: End| {
+        g.node_near(e.dir, None, 2)
+            .and_then(|k| g.node(k))
+            .is_some_and(|n| n.radius > sea + 100.0)
+    };
+    for lat in (-60..60).step_by(7) {
+        for lon in (-180..180).step_by(13) {
+            let (lat, lon) = (f64::from(lat) + 0.3, f64::from(lon) + 0.7);
+            let (a, b) = (offset(lat, lon, 0.0, 0.0), offset(lat, lon, north, east));
+            if high(a) && high(b) {
+                return (a, b);
+            }
+        }
+    }
+    panic!("no land found")
+}
+
+fn nav_lazy(c: &mut Criterion) {
+    let layout = PresetKind::Earth.default_layout(None).expect("the earth layout");
+    let terrain = build(PresetKind::Earth, 7, &layout);
+    let sea = terrain.sea_radius.expect("a sea");
+    let d = terrain.density.clone();
+    let mut g = c.benchmark_group("nav_lazy");
+    g.sample_size(10).measurement_time(Duration::from_secs(30));
+    let diagonal = 10_000.0 * std::f64::consts::FRAC_1_SQRT_2;
+    for (name, offset, options) in [
+        ("earth/10km_east", (0.0, 10_000.0), LazyOptions::default()),
+        ("earth/10km_north_east", (diagonal, diagonal), LazyOptions::default()),
+        (
+            "earth/10km_east/chunk_tiles",
+            (0.0, 10_000.0),
+            LazyOptions {
+                tile_side: 0,
+                ..LazyOptions::default()
+            },
+        ),
+        ("earth/500m_east", (0.0, 500.0), LazyOptions::default()),
+    ] {
+        let (a, b) = land(&d, &layout, sea, offset);
+        let search = SearchOptions::default();
+        let walk = || {
+            let mut grid = LazyGrid::new(d.clone(), &layout, Agent::default(), options).expect("a grid");
+            let found = grid.query(a, b, 8, &search);
+            (found, grid.cache_stats())
+        };
+        let (found, cache) = walk();
+        let PathAnswer::Found(path) = &found.answer else {
+            panic!("{name}: {:?}", found.answer)
+        };
+        eprintln!(
+            "{name}: {:.0} m apart, {:.0} m walked, {} steps, {} nodes expanded, {} tiles built ({} columns a side), {} KiB cached",
+            a.dir.angle_between(b.dir) * sea,
+            path.length,
+            path.nodes.len() - 1,
+            found.stats.expanded,
+            found.stats.tiles_built,
+            if options.tile_side == 0 {
+                layout.n_t()
+            } else {
+                options.tile_side
+            },
+            cache.bytes / 1024
+        );
+        g.bench_function(name, |bch| bch.iter(|| black_box(walk())));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, nav, nav_lazy);
 criterion_main!(benches);

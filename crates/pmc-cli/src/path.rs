@@ -1,18 +1,29 @@
 //! `pmc path`: the walking path between two places on a planet (or a world's edited planet), over
 //! its navigation grid, as JSON or GeoJSON (docs/specs/path-v1.md).
+//!
+//! Planets of up to [`EAGER_COLUMNS`] columns get the whole-planet grid (components known, every
+//! path a shortest one); larger ones, the Earth at true scale among them, get the lazy grid, built
+//! tile by tile around the search within its bounds (`--max-expanded`, `--max-tiles`, `--weight`).
 
 use crate::edit::{parse_place, At};
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
 use clap::{Args, ValueEnum};
 use pmc_geometry::LatLon;
-use pmc_nav::{path_geojson, path_json, query, Agent, End, NavGrid, PathAnswer};
+use pmc_nav::{
+    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, Agent, Columns, End, LazyGrid, LazyOptions,
+    NavGrid, PathAnswer, SearchOptions,
+};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
 /// Columns searched around each end for walkable ground.
 pub const SNAP_RINGS: usize = 8;
+
+/// Layouts with more column slots than this (`6 (N + 1)^2`; `n_c n_t` above about 800) get the
+/// lazy grid.
+pub const EAGER_COLUMNS: usize = 4_000_000;
 
 /// Output formats of `pmc path`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -31,7 +42,7 @@ pub struct PathArgs {
 
     /// Find the path on this world file's planet, with its edits (see `pmc edit`). The planet
     /// options then come from the world and cannot be given.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "seed", "n_c", "n_t", "d_b", "l_d", "d_c"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "seed", "radius", "n_c", "n_t", "d_b", "l_d", "d_c"])]
     world: Option<PathBuf>,
 
     /// Start: latitude and longitude in degrees and, optionally, the altitude in metres above the
@@ -68,7 +79,28 @@ pub struct PathArgs {
     #[arg(long = "max-slope", default_value_t = Agent::default().max_slope, value_name = "DEGREES", allow_negative_numbers = true)]
     max_slope: f64,
 
-    /// Worker threads for building the grid; 0 uses every core.
+    /// Use the lazy grid, built tile by tile around the search, whatever the planet's size (it is
+    /// used anyway above 4 million columns).
+    #[arg(long)]
+    lazy: bool,
+
+    /// Lazy grid: most nodes the search expands before it answers "no path found within the
+    /// search bound".
+    #[arg(long = "max-expanded", default_value_t = SearchOptions::default().max_expanded, value_name = "N")]
+    max_expanded: usize,
+
+    /// Lazy grid: most tiles (4 x 4 columns) the search builds before it answers "no path found
+    /// within the search bound".
+    #[arg(long = "max-tiles", default_value_t = SearchOptions::default().max_tiles_built, value_name = "N")]
+    max_tiles: usize,
+
+    /// Lazy grid: heuristic weight, at least 1; the path is at most this many times the
+    /// shortest (1: a shortest path, which on rough ground may need far more of the bounds).
+    #[arg(long, default_value_t = SearchOptions::default().weight, value_name = "W", allow_negative_numbers = true)]
+    weight: f64,
+
+    /// Worker threads for building the whole-planet grid; 0 uses every core (the lazy grid
+    /// builds on one).
     #[arg(long, default_value_t = 0, value_name = "N")]
     threads: usize,
 
@@ -108,31 +140,55 @@ pub fn run(args: &PathArgs) -> Result<(), CliError> {
         Some(path) => crate::edit::planet_of(&pmc_world::World::open(path)?)?,
         None => args.planet.planet()?,
     };
-    let pool = crate::work::thread_pool(args.threads)?;
-    let start = Instant::now();
-    let grid = pool
-        .install(|| NavGrid::build(planet.density().as_ref(), planet.layout(), agent))
-        .map_err(|e| CliError::Edit(e.to_string()))?;
-    if !args.quiet {
-        eprintln!(
-            "navigation grid: {} nodes in {} components, built in {:.0} ms",
-            grid.node_count(),
-            grid.component_sizes().len(),
-            start.elapsed().as_secs_f64() * 1e3
-        );
-    }
+    let search = SearchOptions {
+        max_expanded: args.max_expanded,
+        max_tiles_built: args.max_tiles,
+        weight: args.weight,
+    };
+    search.validate().map_err(|e| CliError::Edit(e.to_string()))?;
     let datum = planet.datum_radius();
     let (a, b) = (end(from, datum), end(to, datum));
-    let answer = query(&grid, a, b, SNAP_RINGS);
-    if !args.quiet {
-        match &answer {
-            PathAnswer::Found(p) => eprintln!("path: {:.1} m in {} steps", p.length, p.nodes.len() - 1),
-            other => eprintln!("{}", other.reason().unwrap_or_default()),
+    let start = Instant::now();
+    let lazy = args.lazy || Columns::new(planet.layout()).index_count() > EAGER_COLUMNS;
+    let doc = if lazy {
+        let mut grid = LazyGrid::new(planet.density().clone(), planet.layout(), agent, LazyOptions::default())
+            .map_err(|e| CliError::Edit(e.to_string()))?;
+        let found = grid.query(a, b, SNAP_RINGS, &search);
+        if !args.quiet {
+            eprintln!(
+                "lazy navigation grid: {} tiles built ({} nodes), {} nodes expanded, in {:.0} ms",
+                found.stats.tiles_built,
+                grid.cached_nodes(),
+                found.stats.expanded,
+                start.elapsed().as_secs_f64() * 1e3
+            );
+            report(&found.answer);
         }
-    }
-    let doc = match args.format {
-        PathFormat::Json => path_json(&grid, &answer, a, b, datum),
-        PathFormat::Geojson => path_geojson(&grid, &answer, a, b, datum),
+        match args.format {
+            PathFormat::Json => lazy_path_json(&grid, &found, &search, a, b, datum),
+            PathFormat::Geojson => lazy_path_geojson(&grid, &found, &search, a, b, datum),
+        }
+    } else {
+        let pool = crate::work::thread_pool(args.threads)?;
+        let grid = pool
+            .install(|| NavGrid::build(planet.density().as_ref(), planet.layout(), agent))
+            .map_err(|e| CliError::Edit(e.to_string()))?;
+        if !args.quiet {
+            eprintln!(
+                "navigation grid: {} nodes in {} components, built in {:.0} ms",
+                grid.node_count(),
+                grid.component_sizes().len(),
+                start.elapsed().as_secs_f64() * 1e3
+            );
+        }
+        let answer = query(&grid, a, b, SNAP_RINGS);
+        if !args.quiet {
+            report(&answer);
+        }
+        match args.format {
+            PathFormat::Json => path_json(&grid, &answer, a, b, datum),
+            PathFormat::Geojson => path_geojson(&grid, &answer, a, b, datum),
+        }
     };
     let text = format!("{doc:#}\n");
     match &args.output {
@@ -147,4 +203,12 @@ pub fn run(args: &PathArgs) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+/// One line on standard error: the path's length, or why there is none.
+fn report<N>(answer: &PathAnswer<N>) {
+    match answer {
+        PathAnswer::Found(p) => eprintln!("path: {:.1} m in {} steps", p.length, p.nodes.len().saturating_sub(1)),
+        other => eprintln!("{}", other.reason().unwrap_or_default()),
+    }
 }

@@ -212,3 +212,108 @@ fn bad_input_is_refused_clearly() {
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
 }
+
+/// The Earth at true scale: 1 m layers, 6 x 8 388 608^2 columns, far too many for a whole-planet
+/// grid; a walk of about 340 m over the lazy grid.
+const EARTH: [&str; 6] = [
+    "--preset",
+    "earth",
+    "--from=-59.7,41.7",
+    "--to=-59.698,41.703",
+    "--quiet",
+    "--seed=7",
+];
+
+#[test]
+fn a_path_on_the_earth_is_found_on_the_lazy_grid() {
+    let mut args = vec!["path"];
+    args.extend(EARTH);
+    let v = json_out(&args);
+    assert_eq!(
+        (v["format"].as_str(), v["version"].as_u64(), v["found"].as_bool()),
+        (Some("pmc-path"), Some(1), Some(true)),
+        "{v}"
+    );
+    assert_eq!(v["grid"]["lazy"], true);
+    assert!(v["grid"]["components"].is_null() && v["component"].is_null());
+    let tiles = v["search"]["tiles_built"].as_u64().unwrap();
+    assert!(
+        tiles > 0 && tiles < 2000,
+        "{tiles} tiles for a walk of a few hundred metres"
+    );
+    assert_eq!(v["grid"]["tiles"].as_u64(), Some(tiles));
+    assert!(v["search"]["max_tiles"].as_u64().unwrap() >= tiles);
+    let w = v["waypoints"].as_array().unwrap();
+    assert_eq!(w.len() as u64, v["steps"].as_u64().unwrap() + 1);
+    let ll = |x: &Value| (x["lat"].as_f64().unwrap(), x["lon"].as_f64().unwrap());
+    let metres = |a: (f64, f64), b: (f64, f64)| degrees_apart(a, b).to_radians() * 6_371_000.0;
+    // The ends within a few columns of the places asked for, consecutive waypoints one column
+    // (about 1.2 m) apart, and the length at least the great circle between the ends.
+    assert!(metres(ll(&w[0]), (-59.7, 41.7)) < 12.0);
+    assert!(metres(ll(w.last().unwrap()), (-59.698, 41.703)) < 12.0);
+    for pair in w.windows(2) {
+        assert!(metres(ll(&pair[0]), ll(&pair[1])) < 2.0);
+    }
+    let length = v["length"].as_f64().unwrap();
+    let arc = metres(ll(&w[0]), ll(w.last().unwrap()));
+    assert!(
+        arc > 250.0 && length >= arc * 0.999 && length < 2.0 * arc,
+        "{length} vs {arc}"
+    );
+    // Altitudes above the sea, in metres: land here.
+    assert!(w.iter().all(|x| x["alt"].as_f64().unwrap().abs() < 9000.0));
+
+    args.extend(["--format", "geojson"]);
+    let g = json_out(&args);
+    let f = g["features"].as_array().unwrap();
+    assert_eq!(f[0]["geometry"]["coordinates"].as_array().unwrap().len(), w.len());
+    assert_eq!(f[0]["properties"]["length"], v["length"]);
+    assert!(f[0]["properties"]["component"].is_null());
+    assert_eq!(g["properties"]["found"], true);
+    assert_eq!(g["properties"]["search"]["tiles_built"], v["search"]["tiles_built"]);
+}
+
+#[test]
+fn the_search_bound_is_an_answer_of_its_own() {
+    let mut args = vec!["path", "--max-tiles", "5"];
+    args.extend(EARTH);
+    let o = pmc(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["found"], false);
+    assert_eq!(v["cause"], "search_bound");
+    let reason = v["reason"].as_str().unwrap();
+    assert!(reason.contains("no path found within the search bound"), "{reason}");
+    assert!(v["waypoints"].is_null());
+    // Bad bounds are refused before any work.
+    for (flag, value, needle) in [
+        ("--weight", "0.5", "weight"),
+        ("--weight", "NaN", "weight"),
+        ("--max-tiles", "0", "tiles"),
+        ("--max-expanded", "0", "expanded"),
+    ] {
+        let mut args = vec!["path", flag, value];
+        args.extend(EARTH);
+        let o = pmc(&args);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flag} {value}: {e}");
+        assert!(e.contains(needle) && !e.contains("panicked"), "{flag} {value}: {e}");
+    }
+}
+
+#[test]
+fn a_small_planet_gives_the_same_walk_on_either_grid() {
+    let mut args = vec!["path", "--from", "10,10", "--to", "12,40", "--quiet", "--weight", "1"];
+    args.extend(SMALL);
+    let whole = json_out(&args);
+    args.push("--lazy");
+    let lazy = json_out(&args);
+    assert_eq!(
+        (whole["found"].as_bool(), lazy["found"].as_bool()),
+        (Some(true), Some(true))
+    );
+    let (a, b) = (whole["length"].as_f64().unwrap(), lazy["length"].as_f64().unwrap());
+    assert!((a - b).abs() < 1e-9 * a, "{a} vs {b}");
+    assert!(whole["grid"]["components"].as_u64().is_some() && whole["search"].is_null());
+    assert!(lazy["grid"]["components"].is_null() && lazy["search"]["expanded"].as_u64().is_some());
+}

@@ -22,9 +22,14 @@
 //!   touches are sampled again ([`NavGrid::rebuild_for`]).
 //! - **Components** label the nodes joined by steps (either way), so detached grids (Fig. 10) are
 //!   known without a search: nodes in different components have no path between them.
+//!
+//! The grid holds every column of the planet, up to [`MAX_COLUMNS`]. [`crate::LazyGrid`] has the
+//! same floors and steps (the rules are one implementation) for planets of any size, built tile
+//! by tile around a query, without components.
 
 use crate::agent::{Agent, AgentError};
 use crate::columns::{ColumnPlace, Columns};
+use crate::rules::{ColumnView, Rules};
 use pmc_density::Density;
 use pmc_edit::{affected_chunks, BrushOp};
 use pmc_geometry::glam::DVec3;
@@ -132,8 +137,11 @@ pub enum NavError {
     /// Invalid agent limits.
     #[error(transparent)]
     Agent(#[from] AgentError),
+    /// Invalid options.
+    #[error("{0}")]
+    Options(String),
     /// The layout has too many columns.
-    #[error("a navigation grid of this layout would have {columns} columns, more than {MAX_COLUMNS}; use a smaller n_c or n_t")]
+    #[error("a navigation grid of this layout would have {columns} columns, more than {MAX_COLUMNS}; use a smaller n_c or n_t, or the lazy grid")]
     TooLarge {
         /// The columns it would have.
         columns: usize,
@@ -159,13 +167,8 @@ pub struct NavGrid {
     pair_label: Vec<u32>,
     /// Node count of each component.
     component_sizes: Vec<u32>,
-    /// Clearance in voxels above a node.
-    clearance_layers: u32,
-    /// Layers a step may climb and drop at most (the metre limits, rounded up, plus one).
-    scan_up: u32,
-    scan_down: u32,
-    /// `tan(max_slope)^2`.
-    slope2: f64,
+    /// The agent's limits in layers.
+    rules: Rules,
     min_radius: f64,
 }
 
@@ -192,9 +195,6 @@ impl NavGrid {
         let depth = layout.depth_tiles();
         let radii: Vec<f64> = (0..=depth).map(|k| layout.layer_radius(k)).collect();
         let words = radii.len().div_ceil(64);
-        let l_d = layout.l_d();
-        let voxels = |m: f64| (m / l_d).ceil().max(0.0) as u32;
-        let slope = agent.max_slope.to_radians();
         let mut grid = NavGrid {
             columns,
             agent,
@@ -205,14 +205,7 @@ impl NavGrid {
             pair_base: Vec::new(),
             pair_label: Vec::new(),
             component_sizes: Vec::new(),
-            clearance_layers: voxels(agent.clearance).max(1),
-            scan_up: voxels(agent.step_up) + 1,
-            scan_down: voxels(agent.step_down) + 1,
-            slope2: if agent.max_slope >= 90.0 {
-                f64::INFINITY
-            } else {
-                slope.tan().powi(2)
-            },
+            rules: Rules::new(agent, layout.l_d()),
             min_radius: f64::INFINITY,
             radii,
         };
@@ -445,48 +438,18 @@ impl NavGrid {
         let layers = self.radii.len();
         let mut samples = vec![0.0f32; dirs.len() * layers];
         density.sample_shell(&dirs, &self.radii, &mut samples);
-        let top = layers - 1;
-        let mut bits = vec![0u64; columns.len() * self.words];
+        let top = layers as i64 - 1;
+        let mut bits = Vec::with_capacity(columns.len() * self.words);
         let mut starts = Vec::with_capacity(columns.len() + 1);
         let mut nodes = Vec::new();
         let mut d = vec![0.0f32; layers];
         for col in 0..columns.len() {
-            // The shell contract: innermost layer solid, outermost air, NaN air.
             for (k, dk) in d.iter_mut().enumerate() {
-                let raw = samples[k * dirs.len() + col];
-                *dk = if k == 0 {
-                    if raw > 0.0 {
-                        raw
-                    } else {
-                        1.0
-                    }
-                } else if raw.is_nan() || (k == top && raw > 0.0) {
-                    -1.0
-                } else {
-                    raw
-                };
-            }
-            let w = &mut bits[col * self.words..(col + 1) * self.words];
-            for (k, dk) in d.iter().enumerate() {
-                if *dk > 0.0 {
-                    w[k / 64] |= 1 << (k % 64);
-                }
+                *dk = Rules::contract(k as i64, top, samples[k * dirs.len() + col]);
             }
             starts.push(nodes.len() as u32);
-            for k in 0..top {
-                if d[k] > 0.0
-                    && d[k + 1] <= 0.0
-                    && self.air(w, k as i64 + 1, k as i64 + i64::from(self.clearance_layers))
-                {
-                    let (a, b) = (f64::from(d[k]), f64::from(d[k + 1]));
-                    let t = a / (a - b);
-                    let radius = self.radii[k] + t * (self.radii[k + 1] - self.radii[k]);
-                    nodes.push(Node {
-                        layer: k as u32,
-                        radius,
-                    });
-                }
-            }
+            self.rules
+                .column(0, &d, |k| self.radii[k as usize], &mut bits, &mut nodes);
         }
         starts.push(nodes.len() as u32);
         let min_radius = nodes.iter().map(|n| n.radius).fold(f64::INFINITY, f64::min);
@@ -500,25 +463,14 @@ impl NavGrid {
         (tile, bits)
     }
 
-    /// Whether voxel `layer` of a column (its occupancy words) is filled; above the top: no.
-    #[inline]
-    fn filled(words: &[u64], layer: i64) -> bool {
-        if layer < 0 {
-            return true;
-        }
-        let k = layer as usize;
-        k / 64 < words.len() && words[k / 64] & (1 << (k % 64)) != 0
-    }
-
-    /// Whether layers `lo..=hi` of a column are all unfilled.
-    #[inline]
-    fn air(&self, words: &[u64], lo: i64, hi: i64) -> bool {
-        (lo.max(0)..=hi).all(|k| !Self::filled(words, k))
-    }
-
-    fn column_words(&self, column: u32) -> &[u64] {
+    /// The occupancy of a column: every layer sampled, below layer 0 filled, above the top air.
+    fn view(&self, column: u32) -> ColumnView<'_> {
         let at = column as usize * self.words;
-        &self.occupancy[at..at + self.words]
+        ColumnView {
+            base: 0,
+            len: self.radii.len() as i64,
+            words: &self.occupancy[at..at + self.words],
+        }
     }
 
     /// The agent.
@@ -543,7 +495,7 @@ impl NavGrid {
 
     /// Whether voxel `layer` of `column` is filled.
     pub fn is_filled(&self, column: u32, layer: i64) -> bool {
-        Self::filled(self.column_words(column), layer)
+        self.view(column).filled(layer)
     }
 
     /// The tile index and the local index of a canonical column in it.
@@ -587,36 +539,14 @@ impl NavGrid {
     /// The steps from node (`column`, `node`) into the neighbouring column `to` (Fig. 11): one
     /// to each floor of `to` within the agent's step limits whose passage is open.
     pub fn steps_into(&self, column: u32, node: Node, to: u32) -> impl Iterator<Item = Step> + '_ {
-        let (a, b) = (self.column_words(column), self.column_words(to));
-        let h = i64::from(node.layer);
-        let (lo, hi) = (h - i64::from(self.scan_down), h + i64::from(self.scan_up));
+        let (a, b) = (self.view(column), self.view(to));
         let from_dir = self.columns.direction(column);
         let to_dir = self.columns.direction(to);
-        self.column_nodes(to)
-            .filter(move |(_, t)| (lo..=hi).contains(&i64::from(t.layer)))
-            .filter_map(move |(id, reached)| {
-                let target = i64::from(reached.layer);
-                // Voxel by voxel, each column must be open from just above its own floor up to
-                // the higher floor plus the clearance: head room to climb, or the space dropped
-                // through. A filled voxel there (an overhang, a cave ceiling) closes the way.
-                let top = h.max(target) + i64::from(self.clearance_layers);
-                if !self.air(a, h + 1, top) || !self.air(b, target + 1, top) {
-                    return None;
-                }
-                let rise = reached.radius - node.radius;
-                if rise > self.agent.step_up || -rise > self.agent.step_down {
-                    return None;
-                }
-                let chord = (from_dir - to_dir).length();
-                let horizontal = chord * 0.5 * (reached.radius + node.radius);
-                if rise * rise > self.slope2 * horizontal * horizontal {
-                    return None;
-                }
-                Some(Step {
-                    to: id,
-                    cost: (horizontal * horizontal + rise * rise).sqrt(),
-                })
-            })
+        self.column_nodes(to).filter_map(move |(id, reached)| {
+            self.rules
+                .step(a, from_dir, node, b, to_dir, reached)
+                .map(|cost| Step { to: id, cost })
+        })
     }
 
     /// The steps the agent can take from node `id`.

@@ -1,12 +1,18 @@
 //! Navigation on planetary marching cubes (seed 000 Sec. 4.5): a navigation grid of surface
-//! voxels over the whole planet, with the overhang and cave checks of Fig. 11, connected
-//! components (Fig. 10), and A* paths with a great-circle heuristic.
+//! voxels, with the overhang and cave checks of Fig. 11, connected components (Fig. 10), and A*
+//! paths with a great-circle and lattice heuristic; over the whole planet, or built lazily tile
+//! by tile around a query for planets of any size.
 //!
 //! - [`Columns`]: every voxel column of the planet and its neighbours across chunk borders, face
 //!   edges and cube corners.
 //! - [`NavGrid`]: surface voxels (every floor of a column, so cave floors too), the steps an
-//!   [`Agent`] can take between them, and components; rebuilt per tile after an edit.
+//!   [`Agent`] can take between them, and components; rebuilt per tile after an edit. Up to
+//!   [`MAX_COLUMNS`] columns.
 //! - [`find_path`]: the shortest walk between two nodes, or [`NoPath`] (an answer, not an error).
+//! - [`LazyGrid`]: the same nodes and steps, built on first use in small tiles kept in a cache
+//!   bounded in bytes, sampling only a band of layers around each column's top on deep shells
+//!   (the Earth at 1 m voxels); searched within [`SearchOptions`] bounds, answering "no path
+//!   found within the search bound" apart from "no path exists" ([`NoPath`]).
 //!
 //! ```
 //! use pmc_density::Sphere;
@@ -26,11 +32,17 @@
 mod agent;
 mod columns;
 mod grid;
+mod lazy;
 mod report;
+mod rules;
 mod search;
 
 pub use agent::{Agent, AgentError};
-pub use columns::{ColumnPlace, Columns, Neighbours};
+pub use columns::{ColumnPlace, Columns, NeighbourPlaces, Neighbours};
 pub use grid::{NavError, NavGrid, Node, NodeId, Step, TileKey, MAX_COLUMNS};
-pub use report::{path_geojson, path_json, query, waypoint, End, PathAnswer, PATH_FORMAT, PATH_VERSION};
-pub use search::{find_path, NoPath, Path};
+pub use lazy::{CacheStats, LazyAnswer, LazyGrid, LazyOptions, NodeKey};
+pub use report::{
+    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, waypoint, End, PathAnswer, PATH_FORMAT,
+    PATH_VERSION,
+};
+pub use search::{find_path, NoPath, Path, SearchOptions, SearchStats};

@@ -1,8 +1,10 @@
 //! Paths as documents: the JSON and GeoJSON of `docs/specs/path-v1.md`, written by `pmc path`
-//! and the server's `/api/v1/path`.
+//! and the server's `/api/v1/path`, for the whole-planet grid and the lazy grid.
 
-use crate::grid::NavGrid;
-use crate::search::{NoPath, Path};
+use crate::agent::Agent;
+use crate::grid::{NavGrid, NodeId};
+use crate::lazy::{LazyAnswer, LazyGrid};
+use crate::search::{NoPath, Path, SearchOptions};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::LatLon;
 use serde_json::{json, Value};
@@ -42,12 +44,14 @@ impl End {
     }
 }
 
-/// What a path query found: a path, no path (with why), or no walkable ground near an end.
+/// What a path query found: a path, no path (with why), or no walkable ground near an end. `N`
+/// names the nodes: [`NodeId`] on the whole-planet grid, [`crate::NodeKey`] on the lazy grid.
 #[derive(Clone, Debug, PartialEq)]
-pub enum PathAnswer {
+pub enum PathAnswer<N = NodeId> {
     /// A path.
-    Found(Path),
-    /// Both ends are on the grid, and no path joins them.
+    Found(Path<N>),
+    /// Both ends are on the grid, and no path joins them (or none was found within the search
+    /// bound, [`NoPath::SearchBound`]).
     NoPath(NoPath),
     /// No node lies near the start (`true`) or the goal (`false`).
     NoGround {
@@ -56,7 +60,7 @@ pub enum PathAnswer {
     },
 }
 
-impl PathAnswer {
+impl<N> PathAnswer<N> {
     /// Why there is no path, in words (`None` for a path).
     pub fn reason(&self) -> Option<String> {
         match self {
@@ -68,30 +72,88 @@ impl PathAnswer {
             )),
         }
     }
+
+    /// The reason as a short name (`None` for a path): `no_ground`, or [`NoPath::cause`].
+    pub fn cause(&self) -> Option<&'static str> {
+        match self {
+            PathAnswer::Found(_) => None,
+            PathAnswer::NoPath(n) => Some(n.cause()),
+            PathAnswer::NoGround { .. } => Some("no_ground"),
+        }
+    }
 }
 
-/// The JSON document of a path query from `from` to `to` (the points asked for, planet frame).
-pub fn path_json(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
-    let a = grid.agent();
+/// What a document says about the grid, beside the answer.
+struct Facts {
+    agent: Agent,
+    /// The `grid` member.
+    grid: Value,
+    /// The component of a path found.
+    component: Value,
+    /// The `search` member of a lazy grid's documents.
+    search: Option<Value>,
+}
+
+impl Facts {
+    fn eager<N>(grid: &NavGrid, answer: &PathAnswer<N>, first: impl Fn(&Path<N>) -> Option<NodeId>) -> Facts {
+        Facts {
+            agent: *grid.agent(),
+            grid: json!({ "nodes": grid.node_count(), "components": grid.component_sizes().len() }),
+            component: match answer {
+                PathAnswer::Found(p) => json!(first(p).and_then(|n| grid.component(n))),
+                _ => Value::Null,
+            },
+            search: None,
+        }
+    }
+
+    fn lazy(grid: &LazyGrid, answer: &LazyAnswer, options: &SearchOptions) -> Facts {
+        Facts {
+            agent: *grid.agent(),
+            grid: json!({
+                "lazy": true,
+                "tiles": grid.cache_stats().tiles,
+                "nodes": grid.cached_nodes(),
+                "components": Value::Null,
+            }),
+            component: Value::Null,
+            search: Some(json!({
+                "expanded": answer.stats.expanded,
+                "backward": answer.stats.backward,
+                "tiles_built": answer.stats.tiles_built,
+                "max_expanded": options.max_expanded,
+                "max_tiles": options.max_tiles_built,
+                "weight": options.weight,
+            })),
+        }
+    }
+}
+
+fn json_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End, datum: f64) -> Value {
+    let a = facts.agent;
     let mut v = json!({
         "format": PATH_FORMAT,
         "version": PATH_VERSION,
         "found": matches!(answer, PathAnswer::Found(_)),
         "asked": { "from": from.json(datum), "to": to.json(datum) },
         "agent": { "clearance": a.clearance, "step_up": a.step_up, "step_down": a.step_down, "max_slope": a.max_slope },
-        "grid": { "nodes": grid.node_count(), "components": grid.component_sizes().len() },
+        "grid": facts.grid,
     });
+    if let Some(search) = facts.search {
+        v["search"] = search;
+    }
     match answer {
         PathAnswer::Found(p) => {
             let w: Vec<Value> = p.points.iter().map(|q| waypoint(*q, datum)).collect();
             v["length"] = json!(p.length);
             v["steps"] = json!(p.nodes.len().saturating_sub(1));
-            v["component"] = json!(grid.component(p.nodes[0]));
+            v["component"] = facts.component;
             v["waypoints"] = json!(w);
             v["expanded"] = json!(p.expanded);
         }
         other => {
             v["reason"] = json!(other.reason());
+            v["cause"] = json!(other.cause());
             if let PathAnswer::NoPath(NoPath::DifferentComponents { from, to }) = other {
                 v["components"] = json!([from, to]);
             }
@@ -100,10 +162,7 @@ pub fn path_json(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum:
     v
 }
 
-/// The GeoJSON (RFC 7946) of a path query: a `FeatureCollection` holding the path as a
-/// `LineString` of `[lon, lat, alt]` (when found) and the two ends asked for as `Point`s
-/// (`[lon, lat]`, with the altitude when one was asked for).
-pub fn path_geojson(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
+fn geojson_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End, datum: f64) -> Value {
     let coords = |p: DVec3| {
         let w = waypoint(p, datum);
         json!([w["lon"], w["lat"], w["alt"]])
@@ -123,17 +182,70 @@ pub fn path_geojson(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, dat
             "type": "Feature",
             "geometry": { "type": "LineString", "coordinates": line },
             "properties": { "role": "path", "length": p.length, "steps": p.nodes.len().saturating_sub(1),
-                            "component": grid.component(p.nodes[0]) },
+                            "component": facts.component },
         }));
     }
     features.push(point(from, "from"));
     features.push(point(to, "to"));
-    json!({
-        "type": "FeatureCollection",
-        "features": features,
-        "properties": { "format": PATH_FORMAT, "version": PATH_VERSION, "found": matches!(answer, PathAnswer::Found(_)),
-                        "reason": answer.reason() },
-    })
+    let mut properties = json!({
+        "format": PATH_FORMAT, "version": PATH_VERSION, "found": matches!(answer, PathAnswer::Found(_)),
+        "reason": answer.reason(), "cause": answer.cause(),
+    });
+    if let Some(search) = facts.search {
+        properties["search"] = search;
+    }
+    json!({ "type": "FeatureCollection", "features": features, "properties": properties })
+}
+
+/// The JSON document of a path query from `from` to `to` (the points asked for, planet frame).
+pub fn path_json(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
+    json_document(
+        Facts::eager(grid, answer, |p| p.nodes.first().copied()),
+        answer,
+        from,
+        to,
+        datum,
+    )
+}
+
+/// The GeoJSON (RFC 7946) of a path query: a `FeatureCollection` holding the path as a
+/// `LineString` of `[lon, lat, alt]` (when found) and the two ends asked for as `Point`s
+/// (`[lon, lat]`, with the altitude when one was asked for).
+pub fn path_geojson(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
+    geojson_document(
+        Facts::eager(grid, answer, |p| p.nodes.first().copied()),
+        answer,
+        from,
+        to,
+        datum,
+    )
+}
+
+/// [`path_json`] of a query of the lazy grid ([`LazyGrid::query`] with `options`): the grid is
+/// described by the tiles its cache holds, components are null (a lazy grid has none), and a
+/// `search` member gives the search's counts and bounds (`docs/specs/path-v1.md`, 1.1).
+pub fn lazy_path_json(
+    grid: &LazyGrid,
+    answer: &LazyAnswer,
+    options: &SearchOptions,
+    from: End,
+    to: End,
+    datum: f64,
+) -> Value {
+    json_document(Facts::lazy(grid, answer, options), &answer.answer, from, to, datum)
+}
+
+/// [`path_geojson`] of a query of the lazy grid, with the `search` member in the top-level
+/// properties.
+pub fn lazy_path_geojson(
+    grid: &LazyGrid,
+    answer: &LazyAnswer,
+    options: &SearchOptions,
+    from: End,
+    to: End,
+    datum: f64,
+) -> Value {
+    geojson_document(Facts::lazy(grid, answer, options), &answer.answer, from, to, datum)
 }
 
 /// Finds the path between the walkable ground nearest to `from` and `to`: each end is, in the
