@@ -30,7 +30,7 @@
 //! result is exactly the brute-force list, visiting only chunks near the point.
 
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{face_uv_to_sphere, ChunkKey, Face, Layout};
+use pmc_geometry::{face_uv_to_cube, face_uv_to_sphere, ChunkKey, Face, Layout};
 use pmc_planet::Planet;
 
 /// Upper bound (with a 2% margin) of how much `(u, v) -> face_uv_to_sphere(face, u, v)` stretches
@@ -60,8 +60,8 @@ impl BoundingSphere {
 }
 
 /// A cap on the unit sphere: the directions within `angle` of `axis`.
-#[derive(Clone, Copy, Debug)]
-struct Cap {
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Cap {
     axis: DVec3,
     angle: f64,
 }
@@ -73,14 +73,45 @@ pub(crate) fn angle_between(a: DVec3, b: DVec3) -> f64 {
 
 /// The cap holding the image of the face rectangle `[u0, u1] x [v0, v1]`, from `samples + 1`
 /// samples per side of its border.
+///
+/// The angle is the largest of `atan2(|a x p|, a . p)` over the samples `p` (normalised). That
+/// is evaluated only where it can be the largest: for the samples whose tangent
+/// `|a x p| / a . p`, estimated on a direction computed with a few products where
+/// `face_uv_to_sphere` divides, comes within [`RATIO_MARGIN`] (relative) or [`TANGENT_SLACK`]
+/// (absolute) of the largest. A sample further below has a smaller angle by far more than the
+/// rounding of `atan2`, of the normalisation and of the estimate (a few units in the last place
+/// of numbers near 1), so the result has the same bits as the largest `atan2` over every sample.
+/// Samples at 90 degrees or more from the axis, or anything not finite, fall back to evaluating
+/// every sample.
 fn rect_cap(face: Face, u0: f64, u1: f64, v0: f64, v1: f64, samples: u32) -> Cap {
     let axis = face_uv_to_sphere(face, 0.5 * (u0 + u1), 0.5 * (v0 + v1)).normalize();
-    let mut angle: f64 = 0.0;
     let m = f64::from(samples);
+    // Each sample, its squared sine and squared cosine (of the estimate, not normalised).
+    let mut found = Vec::with_capacity(4 * (samples as usize + 1));
+    let (mut best_sin2, mut best_cos2) = (0.0f64, 1.0f64);
+    let mut ahead = true;
     for s in 0..=samples {
         let t = f64::from(s) / m;
         let (u, v) = (u0 + (u1 - u0) * t, v0 + (v1 - v0) * t);
         for (su, sv) in [(u, v0), (u, v1), (u0, v), (u1, v)] {
+            let p = direction_estimate(face, su, sv);
+            let (sin2, cos) = (axis.cross(p).length_squared(), axis.dot(p));
+            let cos2 = cos * cos;
+            if cos > 0.0 && sin2.is_finite() && sin2 <= MAX_RATIO * MAX_RATIO * cos2 {
+                if sin2 * best_cos2 > best_sin2 * cos2 {
+                    (best_sin2, best_cos2) = (sin2, cos2);
+                }
+            } else {
+                ahead = false;
+            }
+            found.push((su, sv, sin2, cos2));
+        }
+    }
+    let low = ((best_sin2 / best_cos2).sqrt() * (1.0 - RATIO_MARGIN) - TANGENT_SLACK).max(0.0);
+    let threshold = low * low;
+    let mut angle: f64 = 0.0;
+    for (su, sv, sin2, cos2) in found {
+        if !ahead || sin2 >= threshold * cos2 {
             angle = angle.max(angle_between(axis, face_uv_to_sphere(face, su, sv).normalize()));
         }
     }
@@ -91,14 +122,37 @@ fn rect_cap(face: Face, u0: f64, u1: f64, v0: f64, v1: f64, samples: u32) -> Cap
     }
 }
 
-/// Squared distance from `h a` to a point at radius `r` and angle `angle` from `a`.
-fn dist2(r: f64, h: f64, angle: f64) -> f64 {
-    let s = (0.5 * angle).sin();
-    (r - h) * (r - h) + 4.0 * r * h * s * s
+/// [`face_uv_to_sphere`] with products by `1 / 3` where it divides by 3: within a few units in
+/// the last place of it.
+fn direction_estimate(face: Face, u: f64, v: f64) -> DVec3 {
+    const THIRD: f64 = 1.0 / 3.0;
+    let c = face_uv_to_cube(face, u, v);
+    let (x2, y2, z2) = (c.x * c.x, c.y * c.y, c.z * c.z);
+    DVec3::new(
+        c.x * (1.0 - y2 * 0.5 - z2 * 0.5 + y2 * z2 * THIRD).sqrt(),
+        c.y * (1.0 - z2 * 0.5 - x2 * 0.5 + z2 * x2 * THIRD).sqrt(),
+        c.z * (1.0 - x2 * 0.5 - y2 * 0.5 + x2 * y2 * THIRD).sqrt(),
+    )
+}
+
+/// [`rect_cap`] evaluates `atan2` only for samples whose tangent is within this relative margin
+/// of the largest, or within [`TANGENT_SLACK`] of it.
+const RATIO_MARGIN: f64 = 1e-9;
+/// The absolute margin of [`rect_cap`]'s tangents: a thousand times the rounding of a sine
+/// computed from unit vectors, for caps so small that the relative margin is not enough.
+const TANGENT_SLACK: f64 = 1e-12;
+/// Tangents above this (angles within 0.06 degrees of 90) make [`rect_cap`] evaluate every
+/// sample: there `atan2` flattens and the margins would no longer dwarf its rounding.
+const MAX_RATIO: f64 = 1e3;
+
+/// Squared distance from `h a` to a point at radius `r` and angle `angle` from `a`, given
+/// `half_sin = sin(angle / 2)`.
+fn dist2(r: f64, h: f64, half_sin: f64) -> f64 {
+    (r - h) * (r - h) + 4.0 * r * h * half_sin * half_sin
 }
 
 /// A sphere holding every point `d r` with `d` in `cap` and `r` in `[r0, r1]` (`0 < r0 <= r1`).
-fn cap_sphere(cap: Cap, r0: f64, r1: f64) -> BoundingSphere {
+pub(crate) fn cap_sphere(cap: Cap, r0: f64, r1: f64) -> BoundingSphere {
     let pad = |radius: f64| radius * RADIUS_FACTOR + 1e-9 * r1;
     if cap.angle >= MAX_CAP_ANGLE {
         return BoundingSphere {
@@ -106,11 +160,11 @@ fn cap_sphere(cap: Cap, r0: f64, r1: f64) -> BoundingSphere {
             radius: pad(r1),
         };
     }
-    let c = cap.angle.cos();
+    let (c, s) = (cap.angle.cos(), (0.5 * cap.angle).sin());
     let (h, d2) = [r0 * c, r1 * c, 0.5 * (r0 + r1) / c, r1]
         .into_iter()
         .map(|h| h.clamp(0.0, r1))
-        .map(|h| (h, dist2(r0, h, cap.angle).max(dist2(r1, h, cap.angle))))
+        .map(|h| (h, dist2(r0, h, s).max(dist2(r1, h, s))))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .unwrap_or((r1, 0.0));
     BoundingSphere {
@@ -130,14 +184,14 @@ fn span(layout: &Layout, level: u8) -> i64 {
 }
 
 /// The cap of the column of chunks `(face, level, i, j, *)`.
-fn column_cap(layout: &Layout, face: Face, level: u8, i: u32, j: u32) -> Cap {
+pub(crate) fn column_cap(layout: &Layout, face: Face, level: u8, i: u32, j: u32) -> Cap {
     let (n, s) = (layout.face_tiles(), span(layout, level));
     let (ti, tj) = (i64::from(i) * s, i64::from(j) * s);
     rect_cap(face, uv(ti, n), uv(ti + s, n), uv(tj, n), uv(tj + s, n), layout.n_t())
 }
 
 /// The radii of the lowest and highest voxel layer of chunks `k` of `level`.
-fn layer_range(layout: &Layout, level: u8, k: u32) -> (f64, f64) {
+pub(crate) fn layer_range(layout: &Layout, level: u8, k: u32) -> (f64, f64) {
     let s = span(layout, level);
     let (lo, hi) = (i64::from(k) * s, (i64::from(k + 1) * s).min(vertex_top(layout, level)));
     (layout.layer_radius(lo), layout.layer_radius(hi.max(lo)))

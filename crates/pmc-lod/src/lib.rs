@@ -60,6 +60,20 @@
 //!    exactly one level coarser (after balancing never more); the side is named in the leaf's own
 //!    face, across a face edge too. Leaves come in key order.
 //!
+//! # Cost
+//!
+//! The rule is computed in time proportional to the chunks near the refinement, not to the
+//! layout: a chunk column's bounding cap (border samples, `atan2` only where it can be the
+//! largest) is computed once and shared by the chunks of the column, and the selector keeps it
+//! for its next selections; the tree is
+//! an arena in which the chunks around a leaf are found from those around its parent; the first
+//! balance round tests only the leaves beside split chunks of their level (the others cannot
+//! need splitting), and each later round only what the splits before it can have changed; a
+//! balance that passes the budget stops there when only its size is needed. The result is the
+//! same, chunk for chunk, as computing the rule the plain way (a test compares them). The
+//! `lod_select` bench of `pmc-bench` times views of the earth at true scale (19 levels, a
+//! thousand chunks of depth) and of the default planet.
+//!
 //! ```
 //! use pmc_geometry::{glam::DVec3, Layout};
 //! use pmc_lod::{LodParams, Selector, View};
@@ -80,11 +94,14 @@ mod adjacency;
 pub mod bounds;
 mod cull;
 mod errors;
+#[cfg(test)]
+mod reference;
 mod region;
 mod select;
+mod tree;
 
 pub use adjacency::{adjacent, OFFSETS};
 pub use cull::{frustum_planes, occluder_radius, sphere_below_horizon, sphere_in_frustum};
 pub use errors::{measure_level_errors, CELLS_PER_CHUNK, MIN_GRADIENT};
 pub use region::{level_for_error, region_chunks, RegionError};
-pub use select::{LodError, LodParams, Selected, Selection, Selector, View, DEFAULT_MAX_CHUNKS};
+pub use select::{LodError, LodParams, Selected, Selection, Selector, View, DEFAULT_MAX_CHUNKS, MAX_KEPT_CAPS};

@@ -1,12 +1,15 @@
-//! Selection of the chunks to draw for one view (the rule is in the crate docs).
+//! Selection of the chunks to draw for one view (the rule is in the crate docs): refinement
+//! nearest first over bounding spheres computed once per selection from one cap per chunk
+//! column, then the balance and the budget's bisection over the octree of the `tree` module.
 
-use crate::adjacency::{adjacent, OFFSETS};
-use crate::bounds::{chunk_sphere, BoundingSphere};
+use crate::bounds::{cap_sphere, column_cap, layer_range, BoundingSphere, Cap};
 use crate::cull::{sphere_below_horizon, sphere_in_frustum};
+use crate::tree::{KeyMap, Tree};
 use pmc_geometry::glam::{DVec3, DVec4};
-use pmc_geometry::{ChunkKey, ChunkSide, Layout, SideMask};
+use pmc_geometry::{ChunkKey, Layout, SideMask};
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::collections::BinaryHeap;
+use std::sync::{Mutex, PoisonError};
 
 /// The default of [`LodParams::max_chunks`].
 pub const DEFAULT_MAX_CHUNKS: usize = 4096;
@@ -147,11 +150,47 @@ pub enum LodError {
 }
 
 /// Selects the chunks to draw for views of one planet layout (see the crate docs for the rule).
-#[derive(Clone, Debug, PartialEq)]
+///
+/// A selector keeps the bounding caps of the chunk columns its selections computed (they depend
+/// on the layout alone, and are the costly part of the bounding spheres) for the next selections,
+/// up to [`MAX_KEPT_CAPS`] of them; a clone starts without them.
 pub struct Selector {
     layout: Layout,
     errors: Vec<f64>,
     occluder: f64,
+    caps: Mutex<KeyMap<Cap>>,
+}
+
+/// The most column caps a [`Selector`] keeps between selections (some 6 MB): a few selections'
+/// worth, cleared when passed.
+pub const MAX_KEPT_CAPS: usize = 100_000;
+
+impl Clone for Selector {
+    fn clone(&self) -> Self {
+        Selector {
+            layout: self.layout,
+            errors: self.errors.clone(),
+            occluder: self.occluder,
+            caps: Mutex::default(),
+        }
+    }
+}
+
+impl PartialEq for Selector {
+    /// Selectors are equal when they select the same: same layout, errors and occluder.
+    fn eq(&self, other: &Self) -> bool {
+        self.layout == other.layout && self.errors == other.errors && self.occluder == other.occluder
+    }
+}
+
+impl std::fmt::Debug for Selector {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Selector")
+            .field("layout", &self.layout)
+            .field("errors", &self.errors)
+            .field("occluder", &self.occluder)
+            .finish_non_exhaustive()
+    }
 }
 
 impl Selector {
@@ -178,6 +217,7 @@ impl Selector {
             layout,
             errors,
             occluder,
+            caps: Mutex::default(),
         })
     }
 
@@ -201,40 +241,53 @@ impl Selector {
     pub fn select(&self, view: &View, params: &LodParams) -> Result<Selection, LodError> {
         check(view, params)?;
         let cap = params.finest_level.min(self.layout.max_level());
-        let mut spheres = Spheres::new(&self.layout);
+        // The caps kept by earlier selections; a selection running meanwhile starts without them.
+        let kept = std::mem::take(&mut *self.caps.lock().unwrap_or_else(PoisonError::into_inner));
+        let mut spheres = Spheres::new(&self.layout, kept);
         let (roots, splits, mut truncated) = self.refinement(view, params, cap, &mut spheres);
-        let build = |n: usize| Tree::new(&self.layout, &roots, &splits[..n], cap);
-        let mut tree = build(splits.len());
-        if tree.leaves.len() > params.max_chunks && !splits.is_empty() {
+        let budget = params.max_chunks;
+        let mut tree = Tree::new(&self.layout);
+        // Balancing may stop as soon as the tree holds more than the budget: then only the
+        // bisection below needs it, and only its size.
+        tree.build(&roots, &splits, cap, budget);
+        if tree.leaf_count() > budget && !splits.is_empty() {
             truncated = true;
             // The longest prefix of the splits whose balanced tree fits, by bisection (the
-            // balanced size grows with the prefix).
+            // balanced size grows with the prefix). The tree of the best prefix so far is kept.
+            let mut best = Tree::new(&self.layout);
+            best.build(&roots, &[], cap, usize::MAX);
             let (mut lo, mut hi) = (0, splits.len());
             while hi - lo > 1 {
                 let mid = lo + (hi - lo) / 2;
-                if build(mid).leaves.len() <= params.max_chunks {
+                tree.build(&roots, &splits[..mid], cap, budget);
+                if tree.leaf_count() <= budget {
                     lo = mid;
+                    std::mem::swap(&mut tree, &mut best);
                 } else {
                     hi = mid;
                 }
             }
-            tree = build(lo);
+            tree = best;
         }
-        let mut keys: Vec<ChunkKey> = tree.leaves.iter().copied().collect();
-        keys.sort_unstable();
-        let chunks = keys
+        let chunks = tree
+            .leaves()
             .into_iter()
-            .map(|key| {
+            .map(|(key, node)| {
                 let sphere = spheres.get(&key);
                 let visible = view.frustum.as_ref().is_none_or(|f| sphere_in_frustum(f, &sphere))
                     && !sphere_below_horizon(view.eye, self.occluder, &sphere);
                 Selected {
                     key,
-                    coarser: tree.coarser(&key),
+                    coarser: tree.coarser(node),
                     drawn: visible,
                 }
             })
             .collect();
+        let mut caps = spheres.caps;
+        if caps.len() > MAX_KEPT_CAPS {
+            caps.clear();
+        }
+        *self.caps.lock().unwrap_or_else(PoisonError::into_inner) = caps;
         Ok(Selection { chunks, truncated })
     }
 
@@ -346,22 +399,38 @@ impl PartialEq for Candidate {
 
 impl Eq for Candidate {}
 
-/// The bounding sphere of each chunk, computed once per selection.
+/// The bounding sphere of each chunk, computed once per selection, from the cap of its column
+/// (shared by the chunks of the column, and the costly part), computed once per selector.
 struct Spheres<'a> {
     layout: &'a Layout,
-    map: HashMap<ChunkKey, BoundingSphere>,
+    caps: KeyMap<Cap>,
+    spheres: KeyMap<BoundingSphere>,
 }
 
 impl<'a> Spheres<'a> {
-    fn new(layout: &'a Layout) -> Self {
+    fn new(layout: &'a Layout, caps: KeyMap<Cap>) -> Self {
         Spheres {
             layout,
-            map: HashMap::new(),
+            caps,
+            spheres: KeyMap::default(),
         }
     }
 
+    /// [`chunk_sphere`](crate::bounds::chunk_sphere) of `key`.
     fn get(&mut self, key: &ChunkKey) -> BoundingSphere {
-        *self.map.entry(*key).or_insert_with(|| chunk_sphere(self.layout, key))
+        if let Some(s) = self.spheres.get(key) {
+            return *s;
+        }
+        let layout = self.layout;
+        let column = ChunkKey { k: 0, ..*key };
+        let cap = *self
+            .caps
+            .entry(column)
+            .or_insert_with(|| column_cap(layout, key.face, key.level, key.i, key.j));
+        let (r0, r1) = layer_range(layout, key.level, key.k);
+        let sphere = cap_sphere(cap, r0, r1);
+        self.spheres.insert(*key, sphere);
+        sphere
     }
 }
 
@@ -371,155 +440,6 @@ fn existing_children(layout: &Layout, key: &ChunkKey) -> Vec<ChunkKey> {
     key.children()
         .map(|c| c.into_iter().filter(|k| layout.contains_chunk(k)).collect())
         .unwrap_or_default()
-}
-
-/// The leaves of the octree being balanced.
-struct Tree<'a> {
-    layout: &'a Layout,
-    leaves: HashSet<ChunkKey>,
-    max_level: u8,
-}
-
-impl<'a> Tree<'a> {
-    /// The roots with `splits` applied in order, then balanced.
-    fn new(layout: &'a Layout, roots: &[ChunkKey], splits: &[ChunkKey], cap: u8) -> Tree<'a> {
-        let mut tree = Tree {
-            layout,
-            leaves: roots.iter().copied().collect(),
-            max_level: layout.max_level(),
-        };
-        for key in splits {
-            tree.split(key);
-        }
-        // The roots alone are all of one level: balanced already.
-        if !splits.is_empty() {
-            tree.balance(cap);
-        }
-        tree
-    }
-
-    /// Replaces the leaf `key` by its children, returning them.
-    fn split(&mut self, key: &ChunkKey) -> Vec<ChunkKey> {
-        self.leaves.remove(key);
-        let children = existing_children(self.layout, key);
-        self.leaves.extend(children.iter().copied());
-        children
-    }
-
-    /// The leaf holding `cell` (`cell` itself or an ancestor), `None` when `cell` is split
-    /// into finer leaves.
-    fn covering(&self, cell: &ChunkKey) -> Option<ChunkKey> {
-        let mut c = *cell;
-        loop {
-            if self.leaves.contains(&c) {
-                return Some(c);
-            }
-            if c.level >= self.max_level {
-                return None;
-            }
-            c = c.parent();
-        }
-    }
-
-    /// The level of the leaves in `cell`: the covering leaf's, or one below the cell's when it
-    /// is split (any finer level compares the same in the rules below).
-    fn level_at(&self, cell: &ChunkKey) -> i32 {
-        self.covering(cell)
-            .map_or(i32::from(cell.level) - 1, |l| i32::from(l.level))
-    }
-
-    /// Whether the leaf `key` must split: a touching leaf is more than one level finer, or one of
-    /// its edges has the checkerboard (this leaf and the leaf diagonally across the edge coarser
-    /// than both leaves beside it).
-    fn must_split(&self, key: &ChunkKey, cap: u8) -> bool {
-        if key.level <= cap {
-            return false;
-        }
-        let level = i32::from(key.level);
-        let Some(children) = key.children() else {
-            return false;
-        };
-        for (n, child) in children.iter().enumerate() {
-            if !self.layout.contains_chunk(child) {
-                continue;
-            }
-            // Outward from this child along u, v and depth.
-            let out = [
-                (n >> 2 & 1) as i8 * 2 - 1,
-                (n >> 1 & 1) as i8 * 2 - 1,
-                (n & 1) as i8 * 2 - 1,
-            ];
-            let towards =
-                |mask: usize| -> [i8; 3] { std::array::from_fn(|a| if mask >> a & 1 == 1 { out[a] } else { 0 }) };
-            // The level-(L-1) cells around the child outside this chunk must not be split.
-            for mask in 1..8 {
-                if let Some(cell) = adjacent(self.layout, child, towards(mask)) {
-                    if self.covering(&cell).is_none() {
-                        return true;
-                    }
-                }
-            }
-            // The half of each edge of this chunk that the child holds.
-            for (p, q) in [(1usize, 2usize), (1, 4), (2, 4)] {
-                let beside_p = adjacent(self.layout, child, towards(p));
-                let beside_q = adjacent(self.layout, child, towards(q));
-                let across = adjacent(self.layout, child, towards(p | q));
-                if let (Some(bp), Some(bq), Some(ac)) = (beside_p, beside_q, across) {
-                    if level.min(self.level_at(&ac)) > self.level_at(&bp).max(self.level_at(&bq)) {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
-    }
-
-    /// Splits leaves until none must split. Each round tests the candidates against the tree as
-    /// it stands, then splits all that must; the next candidates are the new children and the
-    /// leaves of their parent's level or coarser around each split chunk (no other leaf's test
-    /// can change: finer leaves around it only see leaves at least as coarse as themselves
-    /// appear).
-    fn balance(&mut self, cap: u8) {
-        let mut candidates: Vec<ChunkKey> = self.leaves.iter().copied().collect();
-        loop {
-            candidates.sort_unstable();
-            candidates.dedup();
-            let splits: Vec<ChunkKey> = candidates
-                .iter()
-                .filter(|k| self.leaves.contains(k) && self.must_split(k, cap))
-                .copied()
-                .collect();
-            if splits.is_empty() {
-                return;
-            }
-            candidates.clear();
-            for key in &splits {
-                let children = self.split(key);
-                candidates.extend(children);
-            }
-            for key in &splits {
-                for offset in OFFSETS {
-                    if let Some(leaf) = adjacent(self.layout, key, offset).and_then(|c| self.covering(&c)) {
-                        candidates.push(leaf);
-                    }
-                }
-            }
-        }
-    }
-
-    /// The sides of leaf `key` across which the leaf is one level coarser.
-    fn coarser(&self, key: &ChunkKey) -> SideMask {
-        let mut mask = SideMask::NONE;
-        for side in ChunkSide::ALL {
-            let Some(cell) = self.layout.neighbour(key, side, key.level) else {
-                continue;
-            };
-            if self.covering(&cell).is_some_and(|l| l.level == key.level + 1) {
-                mask = mask.with(side);
-            }
-        }
-        mask
-    }
 }
 
 #[cfg(test)]
@@ -620,31 +540,29 @@ mod tests {
         let mut splits = roots.clone();
         splits.push(key(1, 0, 0, 0));
         splits.push(key(1, 1, 1, 0));
-        let mut tree = Tree {
-            layout: &layout,
-            leaves: roots.iter().copied().collect(),
-            max_level: 2,
-        };
+        let mut tree = Tree::new(&layout);
+        tree.build(&roots, &[], 0, usize::MAX);
+        let mut children = Vec::new();
         for s in &splits {
-            tree.split(s);
+            tree.split_key(s, &mut children);
         }
         let coarse = [key(1, 1, 0, 0), key(1, 0, 1, 0)];
         for c in &coarse {
-            assert!(tree.leaves.contains(c));
-            assert!(tree.must_split(c, 0), "{c}");
+            assert!(tree.is_leaf(c));
+            assert!(tree.must_split_key(c, 0), "{c}");
         }
         // Nothing else must split: the tree is 2:1 balanced.
         let others = tree
-            .leaves
+            .leaves()
             .iter()
-            .filter(|k| !coarse.contains(k) && tree.must_split(k, 0))
+            .filter(|(k, _)| !coarse.contains(k) && tree.must_split_key(k, 0))
             .count();
         assert_eq!(others, 0);
-        tree.balance(0);
+        tree.balance(0, usize::MAX);
         for c in &coarse {
-            assert!(!tree.leaves.contains(c));
+            assert!(!tree.is_leaf(c));
         }
-        assert!(tree.leaves.iter().all(|k| !tree.must_split(k, 0)));
+        assert!(tree.leaves().iter().all(|(k, _)| !tree.must_split_key(k, 0)));
     }
 
     #[test]
@@ -659,5 +577,147 @@ mod tests {
             let c = sel.covering(&key).unwrap();
             assert_eq!(c.key.face, key.face);
         }
+    }
+
+    /// Layouts for the comparison with the plain rule: even and odd tile counts, depths that do
+    /// not halve evenly (coarse chunks overhanging the shell, children missing past the depth),
+    /// faces of one to sixteen chunks a side.
+    fn layouts() -> Vec<Layout> {
+        vec![
+            Layout::new(4, 4, 100.0, 1.0, 4).unwrap(),
+            Layout::new(8, 2, 60.0, 2.0, 3).unwrap(),
+            Layout::new(16, 2, 200.0, 1.0, 5).unwrap(),
+            Layout::new(2, 8, 50.0, 1.0, 7).unwrap(),
+            Layout::new(12, 2, 80.0, 1.0, 2).unwrap(),
+            Layout::new(3, 3, 30.0, 1.0, 2).unwrap(),
+            Layout::default(),
+        ]
+    }
+
+    fn doubling(layout: &Layout, scale: f64) -> Vec<f64> {
+        (0..=layout.max_level())
+            .map(|l| {
+                if l == 0 {
+                    0.0
+                } else {
+                    scale * f64::from(1u32 << (l - 1))
+                }
+            })
+            .collect()
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(160))]
+
+        /// The selection equals the plain rule's, chunk for chunk, seams and culling included:
+        /// eyes far, near and inside the shell (next to face edges and cube corners too), with
+        /// and without a frustum, budgets that cut the refinement, a finest level.
+        #[test]
+        fn select_equals_the_plain_rule(
+            which in 0usize..7,
+            dir in proptest::array::uniform3(-1.0f64..1.0),
+            look in proptest::array::uniform3(-1.0f64..1.0),
+            height in proptest::prop_oneof![0.5f64..1.0, 0.95f64..1.05, 1.05f64..3.0],
+            corner in proptest::bool::ANY,
+            scale in 0.02f64..2.0,
+            pixels in 0.5f64..6.0,
+            budget in proptest::prop_oneof![10usize..80, 80usize..600, 600usize..100_000],
+            finest in 0u8..3,
+            with_frustum in proptest::bool::ANY,
+        ) {
+            let layout = layouts()[which];
+            let d = DVec3::from_array(dir);
+            let d = if corner { d.signum() + d * 0.05 } else { d };
+            let eye = d.normalize_or(DVec3::Y) * height * layout.radius();
+            let frustum = with_frustum.then(|| {
+                crate::frustum_planes(eye, DVec3::from_array(look) - eye * 0.5 / eye.length(), DVec3::Y, 1.0, 1.5, 0.1, 1e5)
+            });
+            let selector = Selector::new(layout, doubling(&layout, scale * layout.l_d()), 0.9 * layout.d_b()).unwrap();
+            let view = View { eye, frustum, viewport_height_px: 900.0, fov_y: 1.0 };
+            let params = LodParams { max_pixel_error: pixels, finest_level: finest, max_chunks: budget };
+            let fast = selector.select(&view, &params).unwrap();
+            let plain = crate::reference::select(&selector, &view, &params);
+            proptest::prop_assert_eq!(fast, plain);
+        }
+    }
+
+    /// At the earth's scale (nineteen levels, a thousand chunks of depth), views from the ground
+    /// and from orbit select what the plain rule selects, budget cut or not.
+    #[test]
+    fn earth_scale_selections_equal_the_plain_rule() {
+        let layout = Layout::new(1 << 18, 32, 6_371_000.0 - 16_384.0, 1.0, 1 << 10).unwrap();
+        let errors: Vec<f64> = (0..=layout.max_level())
+            .map(|l| if l == 0 { 0.0 } else { 0.8 * 2f64.powi(i32::from(l) - 1) })
+            .collect();
+        let selector = Selector::new(layout, errors, 6_360_000.0).unwrap();
+        let mut compared = 0;
+        for (dir, height, budget) in [
+            (DVec3::new(0.3, 0.9, 0.1), 2.0, 700),
+            (DVec3::new(1.0, 1.0, 0.999), 50.0, 500),
+            (DVec3::new(-0.2, 0.1, 1.0), 3000.0, 900),
+            (DVec3::new(0.5, -0.7, 0.2), 2.0 * 6_371_000.0, 4096),
+        ] {
+            let eye = dir.normalize() * (6_371_000.0 + height);
+            let frustum = crate::frustum_planes(eye, DVec3::Y - eye.normalize(), eye, 1.0, 1.7, 0.5, 1e8);
+            for frustum in [None, Some(frustum)] {
+                let view = View {
+                    eye,
+                    frustum,
+                    viewport_height_px: 1080.0,
+                    fov_y: 1.0,
+                };
+                let params = LodParams {
+                    max_chunks: budget,
+                    ..LodParams::default()
+                };
+                let fast = selector.select(&view, &params).unwrap();
+                assert_eq!(
+                    fast,
+                    crate::reference::select(&selector, &view, &params),
+                    "{dir} {height}"
+                );
+                compared += fast.chunks.len();
+            }
+        }
+        assert!(compared > 2000, "{compared}");
+    }
+
+    /// The bounding spheres (their caps from border samples, `atan2` only near the largest
+    /// tangent) have the bits of the plain computation, on small layouts and at the earth's
+    /// scale, at every level.
+    #[test]
+    fn spheres_have_the_bits_of_the_plain_computation() {
+        let earth = Layout::new(1 << 18, 32, 6_371_000.0 - 16_384.0, 1.0, 1 << 10).unwrap();
+        // The finest grid there is: 2^24 tiles a face side, chunks a few 1e-7 rad across.
+        let finest = Layout::new(1 << 22, 4, 1e7, 1.0, 4).unwrap();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move |n: u32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % u64::from(n)) as u32
+        };
+        let mut compared = 0;
+        for layout in layouts().into_iter().chain([earth, finest]) {
+            for level in 0..=layout.max_level() {
+                let (n, d) = (layout.chunks_per_side(level), layout.depth_chunks(level));
+                for _ in 0..40 {
+                    let key = ChunkKey {
+                        face: Face::ALL[next(6) as usize],
+                        level,
+                        i: next(n),
+                        j: next(n),
+                        k: next(d),
+                    };
+                    assert_eq!(
+                        crate::bounds::chunk_sphere(&layout, &key),
+                        crate::reference::chunk_sphere(&layout, &key),
+                        "{key}"
+                    );
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared > 1000);
     }
 }

@@ -83,6 +83,25 @@ export function cubeToSphere(c: Vec3): Vec3 {
   ];
 }
 
+const THIRD = 1.0 / 3.0;
+
+/**
+ * {@link faceUvToSphere} with products by 1/3 where it divides by 3 (within a few units in the last
+ * place of it), written into `out` at `at` without allocating: an estimate for searches.
+ */
+export function faceUvDirectionEstimate(face: number, u: number, v: number, out: Float64Array, at: number): void {
+  const f = FRAMES[face];
+  const x = f.n[0] + u * f.u[0] + v * f.v[0];
+  const y = f.n[1] + u * f.u[1] + v * f.v[1];
+  const z = f.n[2] + u * f.u[2] + v * f.v[2];
+  const x2 = x * x;
+  const y2 = y * y;
+  const z2 = z * z;
+  out[at] = x * Math.sqrt(1.0 - y2 * 0.5 - z2 * 0.5 + y2 * z2 * THIRD);
+  out[at + 1] = y * Math.sqrt(1.0 - z2 * 0.5 - x2 * 0.5 + z2 * x2 * THIRD);
+  out[at + 2] = z * Math.sqrt(1.0 - x2 * 0.5 - y2 * 0.5 + x2 * y2 * THIRD);
+}
+
 /** The unit-sphere direction of face coordinates `(u, v)` in `[-1, 1]^2`. */
 export function faceUvToSphere(face: number, u: number, v: number): Vec3 {
   const f = FRAMES[face];
@@ -107,6 +126,9 @@ export class Layout {
   readonly d_b: number;
   readonly l_d: number;
   readonly d_c: number;
+  private readonly perSide: number[] = [];
+  private readonly perDepth: number[] = [];
+  private readonly spans: number[] = [];
 
   constructor(p: LayoutParams) {
     const whole = (x: number): boolean => Number.isInteger(x) && x >= 1;
@@ -124,6 +146,12 @@ export class Layout {
     this.d_b = p.d_b;
     this.l_d = p.l_d;
     this.d_c = p.d_c;
+    // the per-level counts, looked up often by the selection (the same numbers as the formulas)
+    for (let level = 0; level <= this.maxLevel(); level++) {
+      this.perSide.push(Math.floor(this.n_c / 2 ** level));
+      this.perDepth.push(Math.ceil(this.d_c / 2 ** level));
+      this.spans.push(this.n_t * 2 ** level);
+    }
   }
 
   /** `N = n_c n_t`: tiles along a face side. */
@@ -156,17 +184,17 @@ export class Layout {
 
   /** Chunks per face side at `level`. */
   chunksPerSide(level: number): number {
-    return Math.floor(this.n_c / 2 ** level);
+    return this.perSide[level] ?? Math.floor(this.n_c / 2 ** level);
   }
 
   /** Chunks along depth at `level`: `ceil(d_c / 2^level)`. */
   depthChunks(level: number): number {
-    return Math.ceil(this.d_c / 2 ** level);
+    return this.perDepth[level] ?? Math.ceil(this.d_c / 2 ** level);
   }
 
   /** Level-0 grid steps along each axis of a level-`level` chunk. */
   chunkSpan(level: number): number {
-    return this.n_t * 2 ** level;
+    return this.spans[level] ?? this.n_t * 2 ** level;
   }
 
   /** Whether `key` names a chunk of this layout. */

@@ -11,18 +11,24 @@
 //    tree fits (bisection): the farthest chunks stay coarser.
 // 4. Mark leaves outside the frustum or below the horizon as not drawn; give each leaf the sides
 //    across which the leaf region is one level coarser.
+//
+// Computed as the crate computes it: bounding spheres from one cap per chunk column, kept between
+// calls; the octree, its balance in rounds and the leaf test in `tree.ts`.
 
-import { chunkSphere, angleBetween, len, sphereDistance, type BoundingSphere } from './bounds';
 import {
-  childrenOf,
-  compareKeys,
-  keyId,
-  parentOf,
-  type ChunkKey,
-  type Layout,
-  type Side,
-  type Vec3,
-} from './layout';
+  angleBetween,
+  capSphere,
+  columnCap,
+  layerRange,
+  len,
+  sphereDistance,
+  type BoundingSphere,
+  type Cap,
+} from './bounds';
+import { childrenOf, compareKeys, keyId, type ChunkKey, type Layout, type Vec3 } from './layout';
+import { Tree } from './tree';
+
+export { adjacent } from './tree';
 
 /** A frustum plane `[nx, ny, nz, d]`: inside where `n . p + d >= 0`. */
 export type Plane = [number, number, number, number];
@@ -96,151 +102,8 @@ export function sphereBelowHorizon(eye: Vec3, occluder: number, s: BoundingSpher
   return spread < alpha * (1.0 - MARGIN) - MARGIN;
 }
 
-/** The offset's side along `axis` (0 u, 1 v, 2 depth), or null for no step. */
-function sideOf(axis: number, d: number): Side | null {
-  if (d === 0) return null;
-  return (2 * axis + (d > 0 ? 1 : 0)) as Side;
-}
-
-/** The chunk of `key`'s level at `offset` [du, dv, dk] from it (`pmc_lod::adjacent`). */
-export function adjacent(layout: Layout, key: ChunkKey, offset: [number, number, number]): ChunkKey | null {
-  if (offset.some((d) => d < -1 || d > 1 || !Number.isInteger(d)) || offset.every((d) => d === 0)) return null;
-  if (!layout.containsChunk(key)) return null;
-  const level = key.level;
-  const su = sideOf(0, offset[0]);
-  const sv = sideOf(1, offset[1]);
-  let cur: ChunkKey | null = key;
-  if (su !== null && sv !== null) {
-    const first = layout.neighbour(cur, su, level);
-    if (first === null) return null;
-    if (first.face === cur.face) {
-      cur = layout.neighbour(first, sv, level);
-    } else {
-      const other = layout.neighbour(cur, sv, level);
-      if (other === null || other.face !== cur.face) return null;
-      cur = layout.neighbour(other, su, level);
-    }
-  } else if (su !== null || sv !== null) {
-    cur = layout.neighbour(cur, (su ?? sv) as Side, level);
-  }
-  if (cur === null) return null;
-  const sd = sideOf(2, offset[2]);
-  if (sd !== null) cur = layout.neighbour(cur, sd, level);
-  return cur;
-}
-
-/** The 26 offsets in lexicographic order. */
-const OFFSETS: [number, number, number][] = [];
-for (let a = -1; a <= 1; a++) {
-  for (let b = -1; b <= 1; b++) {
-    for (let c = -1; c <= 1; c++) if (a !== 0 || b !== 0 || c !== 0) OFFSETS.push([a, b, c]);
-  }
-}
-
 const existingChildren = (layout: Layout, key: ChunkKey): ChunkKey[] =>
   childrenOf(key).filter((c) => layout.containsChunk(c));
-
-/** The leaves of the octree being balanced. */
-class Tree {
-  readonly leaves = new Map<string, ChunkKey>();
-  private readonly maxLevel: number;
-
-  constructor(
-    private readonly layout: Layout,
-    roots: ChunkKey[],
-    splits: ChunkKey[],
-    cap: number,
-  ) {
-    this.maxLevel = layout.maxLevel();
-    for (const r of roots) this.leaves.set(keyId(r), r);
-    for (const s of splits) this.split(s);
-    // The roots alone are all of one level: balanced already.
-    if (splits.length > 0) this.balance(cap);
-  }
-
-  split(key: ChunkKey): ChunkKey[] {
-    this.leaves.delete(keyId(key));
-    const children = existingChildren(this.layout, key);
-    for (const c of children) this.leaves.set(keyId(c), c);
-    return children;
-  }
-
-  covering(cell: ChunkKey): ChunkKey | null {
-    let c = cell;
-    for (;;) {
-      const leaf = this.leaves.get(keyId(c));
-      if (leaf !== undefined) return leaf;
-      if (c.level >= this.maxLevel) return null;
-      c = parentOf(c);
-    }
-  }
-
-  levelAt(cell: ChunkKey): number {
-    const leaf = this.covering(cell);
-    return leaf === null ? cell.level - 1 : leaf.level;
-  }
-
-  mustSplit(key: ChunkKey, cap: number): boolean {
-    if (key.level <= cap) return false;
-    const children = childrenOf(key);
-    for (let n = 0; n < children.length; n++) {
-      const child = children[n];
-      if (!this.layout.containsChunk(child)) continue;
-      const out = [((n >> 2) & 1) * 2 - 1, ((n >> 1) & 1) * 2 - 1, (n & 1) * 2 - 1];
-      const towards = (mask: number): [number, number, number] => [
-        mask & 1 ? out[0] : 0,
-        mask & 2 ? out[1] : 0,
-        mask & 4 ? out[2] : 0,
-      ];
-      for (let mask = 1; mask < 8; mask++) {
-        const cell = adjacent(this.layout, child, towards(mask));
-        if (cell !== null && this.covering(cell) === null) return true;
-      }
-      for (const [p, q] of [
-        [1, 2],
-        [1, 4],
-        [2, 4],
-      ]) {
-        const bp = adjacent(this.layout, child, towards(p));
-        const bq = adjacent(this.layout, child, towards(q));
-        const ac = adjacent(this.layout, child, towards(p | q));
-        if (bp !== null && bq !== null && ac !== null) {
-          if (Math.min(key.level, this.levelAt(ac)) > Math.max(this.levelAt(bp), this.levelAt(bq))) return true;
-        }
-      }
-    }
-    return false;
-  }
-
-  balance(cap: number): void {
-    let candidates = [...this.leaves.values()];
-    for (;;) {
-      const splits = candidates.filter((k) => this.leaves.has(keyId(k)) && this.mustSplit(k, cap));
-      if (splits.length === 0) return;
-      const next = new Map<string, ChunkKey>();
-      for (const s of splits) for (const c of this.split(s)) next.set(keyId(c), c);
-      for (const s of splits) {
-        for (const o of OFFSETS) {
-          const cell = adjacent(this.layout, s, o);
-          const leaf = cell === null ? null : this.covering(cell);
-          if (leaf !== null) next.set(keyId(leaf), leaf);
-        }
-      }
-      candidates = [...next.values()];
-    }
-  }
-
-  coarser(key: ChunkKey): number {
-    let mask = 0;
-    for (let side = 0; side < 6; side++) {
-      const cell = this.layout.neighbour(key, side as Side, key.level);
-      if (cell === null) continue;
-      const leaf = this.covering(cell);
-      if (leaf !== null && leaf.level === key.level + 1) mask |= 1 << side;
-    }
-    return mask;
-  }
-}
 
 /** A min-heap of refinement candidates: nearest first, ties by key. */
 class CandidateHeap {
@@ -315,9 +178,79 @@ function checkInput(layout: Layout, errors: number[], occluder: number, view: Lo
   if (!(Number.isFinite(params.maxPixelError) && params.maxPixelError > 0)) throw new Error('bad pixel error bound');
 }
 
+/** The most spheres a {@link SphereCache} keeps: a few selections' worth. */
+const MAX_CACHED_SPHERES = 200_000;
+
+/**
+ * The bounding spheres of one layout's chunks, computed once: each from the cap of its column
+ * (shared by the chunks of the column, and the costly part), kept by face and level under a
+ * number naming the column or the chunk (a string where the layout's numbers would pass 2^53).
+ */
+class SphereCache {
+  private readonly caps = new Map<number, Map<number | string, Cap>>();
+  private readonly spheres = new Map<number, Map<number | string, BoundingSphere>>();
+  private count = 0;
+  private readonly exact: boolean;
+
+  constructor(private readonly layout: Layout) {
+    const side = layout.chunksPerSide(0);
+    this.exact = side * side * layout.depthChunks(0) <= Number.MAX_SAFE_INTEGER;
+  }
+
+  /** Whether this cache holds spheres of `layout`'s chunks. */
+  serves(layout: Layout): boolean {
+    const l = this.layout;
+    const same = l.n_c === layout.n_c && l.n_t === layout.n_t && l.d_c === layout.d_c;
+    return l === layout || (same && l.d_b === layout.d_b && l.l_d === layout.l_d);
+  }
+
+  /** The bounding sphere of chunk `k` (`chunkSphere`). */
+  sphere(k: ChunkKey): BoundingSphere {
+    const group = k.face * 32 + k.level;
+    const side = this.layout.chunksPerSide(k.level);
+    const column = k.i * side + k.j;
+    const id = this.exact ? column * this.layout.depthChunks(k.level) + k.k : `${k.i}/${k.j}/${k.k}`;
+    let spheres = this.spheres.get(group);
+    if (spheres === undefined) {
+      spheres = new Map();
+      this.spheres.set(group, spheres);
+    }
+    let s = spheres.get(id);
+    if (s !== undefined) return s;
+    if (this.count >= MAX_CACHED_SPHERES) {
+      this.caps.clear();
+      this.spheres.clear();
+      this.count = 0;
+      spheres = new Map();
+      this.spheres.set(group, spheres);
+    }
+    let caps = this.caps.get(group);
+    if (caps === undefined) {
+      caps = new Map();
+      this.caps.set(group, caps);
+    }
+    let c = caps.get(column);
+    if (c === undefined) {
+      c = columnCap(this.layout, k.face, k.level, k.i, k.j);
+      caps.set(column, c);
+    }
+    const [r0, r1] = layerRange(this.layout, k.level, k.k);
+    s = capSphere(c, r0, r1);
+    spheres.set(id, s);
+    this.count++;
+    return s;
+  }
+}
+
+/** The sphere caches, by the map the caller keeps between calls (see {@link selectLod}). */
+const sphereCaches = new WeakMap<Map<string, BoundingSphere>, SphereCache>();
+
 /**
  * The chunks to draw for `view`: `errors[L]` is each level's geometric error in metres, `occluder`
- * the radius of a ball solid at every level (0: no horizon culling). Throws on malformed input.
+ * the radius of a ball solid at every level (0: no horizon culling). Passing the same `spheres`
+ * map from one call to the next for the same layout keeps the chunks' bounding spheres between
+ * them (in a bounded cache that the map names); the map receives each selected chunk's sphere
+ * by `keyId`. Throws on malformed input.
  */
 export function selectLod(
   layout: Layout,
@@ -325,19 +258,16 @@ export function selectLod(
   occluder: number,
   view: LodView,
   params: LodParams,
+  spheres: Map<string, BoundingSphere> = new Map(),
 ): LodSelection {
   checkInput(layout, errors, occluder, view, params);
   const cap = Math.min(params.finestLevel, layout.maxLevel());
-  const spheres = new Map<string, BoundingSphere>();
-  const sphere = (k: ChunkKey): BoundingSphere => {
-    const id = keyId(k);
-    let s = spheres.get(id);
-    if (s === undefined) {
-      s = chunkSphere(layout, k);
-      spheres.set(id, s);
-    }
-    return s;
-  };
+  let cache = sphereCaches.get(spheres);
+  if (cache === undefined || !cache.serves(layout)) {
+    cache = new SphereCache(layout);
+    sphereCaches.set(spheres, cache);
+  }
+  const sphere = cache.sphere.bind(cache);
   // Refinement, nearest first.
   const roots = layout.chunks(layout.maxLevel());
   const splits: ChunkKey[] = [];
@@ -362,25 +292,35 @@ export function selectLod(
       for (const k of children) heap.push(sphereDistance(sphere(k), view.eye), k);
     }
   }
-  // Balance, and the budget by bisection over the prefix of the splits.
-  const build = (n: number): Tree => new Tree(layout, roots, splits.slice(0, n), cap);
-  let tree = build(splits.length);
-  if (tree.leaves.size > params.maxChunks && splits.length > 0) {
+  // Balance, and the budget by bisection over the prefix of the splits; balancing may stop as
+  // soon as the tree holds more than the budget, when only its size matters.
+  const budget = params.maxChunks;
+  let tree = new Tree(layout);
+  tree.build(roots, splits, cap, budget);
+  if (tree.leaves > budget && splits.length > 0) {
     truncated = true;
+    // the tree of the best prefix so far is kept
+    let best = new Tree(layout);
+    best.build(roots, [], cap, Infinity);
     let lo = 0;
     let hi = splits.length;
     while (hi - lo > 1) {
       const mid = lo + Math.floor((hi - lo) / 2);
-      if (build(mid).leaves.size <= params.maxChunks) lo = mid;
-      else hi = mid;
+      tree.build(roots, splits.slice(0, mid), cap, budget);
+      if (tree.leaves <= budget) {
+        lo = mid;
+        [tree, best] = [best, tree];
+      } else {
+        hi = mid;
+      }
     }
-    tree = build(lo);
+    tree = best;
   }
-  const keys = [...tree.leaves.values()].sort(compareKeys);
-  const chunks = keys.map((key): SelectedChunk => {
+  const chunks = tree.leafNodes().map(({ key, node }): SelectedChunk => {
     const s = sphere(key);
+    spheres.set(keyId(key), s);
     const inView = view.frustum === null || sphereInFrustum(view.frustum, s);
-    return { key, coarser: tree.coarser(key), drawn: inView && !sphereBelowHorizon(view.eye, occluder, s) };
+    return { key, coarser: tree.coarser(node), drawn: inView && !sphereBelowHorizon(view.eye, occluder, s) };
   });
   return { chunks, truncated };
 }
