@@ -42,11 +42,24 @@ export interface PlanetInfo {
   depth_tiles: number;
   /** Highest level of detail of the layout (absent from older servers). */
   max_level?: number;
+  /** What a level-of-detail selection needs (absent from servers without levels of detail). */
+  lod?: LodInfo;
   faces: FaceInfo[];
   materials: string[];
   palette: { a: Vec3Tuple; b: Vec3Tuple };
   /** Editing (absent from servers older than the editing API: treated as disabled). */
   edit?: EditInfo;
+}
+
+/** `/planet`'s `lod` block. */
+export interface LodInfo {
+  max_level: number;
+  /** `errors[L]`: the measured geometric error of level `L`, metres (`errors[0] = 0`). */
+  errors: number[];
+  /** A ball solid at every level: what lies behind it is hidden (horizon culling). */
+  occluder_radius: number;
+  /** The side names in the bit order of a chunk's `seams` mask. */
+  seam_sides: string[];
 }
 
 /** The brushes of `POST /edits`. */
@@ -98,7 +111,7 @@ export interface EditAnswer {
   revision: number;
   active: number;
   redo: number;
-  /** Keys of every level-0 chunk whose mesh may have changed. */
+  /** Names of every chunk, of every level, whose mesh (any seams variant) may have changed. */
   chunks: string[];
 }
 
@@ -168,21 +181,10 @@ export interface NavGridAnswer {
   total_components: number;
 }
 
-export interface ChunkEntry {
-  key: string;
-  face: string;
-  level: number;
-  i: number;
-  j: number;
-  k: number;
-  center: Vec3Tuple;
-  radius: number;
-  distance: number;
-}
-
-export interface ChunkList {
-  chunks: ChunkEntry[];
-  total_in_range: number;
+/** How a chunk is asked for: its seams mask (0 to 63) and the priority of its job. */
+export interface ChunkOptions {
+  seams?: number;
+  priority?: number;
 }
 
 export interface PlanetChoice {
@@ -297,26 +299,19 @@ export class PmcApi {
     return info;
   }
 
-  chunks(
-    planet: PlanetChoice,
-    at: Vec3Tuple,
-    range: number,
-    limit = 4096,
-    signal?: AbortSignal,
-  ): Promise<ChunkList> {
-    return this.json(
-      this.url('chunks', planet, { x: at[0], y: at[1], z: at[2], range, limit }),
-      signal,
-    );
+  /**
+   * The URL of one chunk mesh (`chunk/<face>/<level>/<i>/<j>/<k>`), with its `seams` mask (sides
+   * toward a coarser neighbour) and the `priority` of its job on the server when given.
+   */
+  chunkUrl(planet: PlanetChoice, key: string, opts: ChunkOptions = {}): string {
+    const params: Record<string, number> = {};
+    if (opts.seams !== undefined) params['seams'] = opts.seams;
+    if (opts.priority !== undefined) params['priority'] = opts.priority;
+    return this.url(`chunk/${key}`, planet, params);
   }
 
-  /** The path of one chunk mesh (`chunk/<face>/<level>/<i>/<j>/<k>`). */
-  chunkUrl(planet: PlanetChoice, key: string): string {
-    return this.url(`chunk/${key}`, planet);
-  }
-
-  async chunk(planet: PlanetChoice, key: string, signal?: AbortSignal): Promise<DecodedChunk> {
-    const url = this.chunkUrl(planet, key);
+  async chunk(planet: PlanetChoice, key: string, signal?: AbortSignal, opts: ChunkOptions = {}): Promise<DecodedChunk> {
+    const url = this.chunkUrl(planet, key, opts);
     const res = await this.request(url, signal);
     const bytes = await res.arrayBuffer();
     try {

@@ -17,12 +17,15 @@ import {
   type CameraMode,
   type CameraState,
 } from './cameraModel';
-import { ChunkStreamer } from './chunkStreamer';
-import { loadRange } from './chunkSelection';
+import { ChunkStreamer, type LodPlanet, type StreamerStats } from './chunkStreamer';
+import { formatLevels, loadRange } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
 import { toolByName, toolForKey, type ToolName } from './editTools';
 import { addScaled, cameraBasis, enuAt, length, normalize, wrapLon, type V3 } from './frames';
 import { Input } from './input';
+import { Layout } from './lod/layout';
+import type { Plane } from './lod/select';
+import { LodSelector, planesToPlanetFrame, sameView, type SelectionResult, type ViewState } from './lodSelector';
 import { NavGridLoader, groundPoint, navRange, type NavGridStatus } from './navOverlay';
 import { NavScene } from './navScene';
 import { PATH_TOOL, PathTool, type PathStatus } from './pathTool';
@@ -34,12 +37,31 @@ import { formatHash, parseHash, type UrlState } from './urlState';
 
 export type ModeName = CameraMode | 'walk';
 
+/** The level-of-detail streaming as `__pmc.stats().lod` shows it. */
+export interface PmcLodStats extends Omit<StreamerStats, 'loaded' | 'pending' | 'missing' | 'triangles' | 'vertices' | 'requested' | 'failed' | 'stale' | 'reloading' | 'reloads'> {
+  /** The stats panel's histogram line, e.g. `L0 12 · L1 40 · L2 18`. */
+  levelsText: string;
+  /** The selection's settings. */
+  maxPixelError: number;
+  maxChunks: number;
+  /** The last selection's time, milliseconds, and whether one is running. */
+  selectMs: number;
+  selecting: boolean;
+  /** The last selection was made for the current view. */
+  current: boolean;
+  /** The planet has no `lod` block (an older server): level 0 everywhere. */
+  levelZeroOnly: boolean;
+}
+
 export interface PmcStats {
   preset: string | null;
   seed: string | null;
+  /** Chunks shown, loaded (in the cache, shown or not), pending and wanted but not asked yet. */
+  shown: number;
   loaded: number;
   pending: number;
   missing: number;
+  /** Triangles and vertices shown. */
   triangles: number;
   vertices: number;
   requested: number;
@@ -58,7 +80,9 @@ export interface PmcStats {
   drawCalls: number;
   ready: boolean;
   error: string | null;
+  /** The chunks shown (`face/level/i/j/k`). */
   loadedKeys: string[];
+  lod: PmcLodStats;
   /** Loaded chunks waiting for a refetch after an edit, refetches under way, refetches made. */
   stale: number;
   reloading: number;
@@ -107,7 +131,10 @@ export interface PickResult {
 
 export interface PmcTestHook {
   stats(): PmcStats;
-  /** Resolves when no chunk is pending or missing and at least one is loaded and drawn. */
+  /**
+   * Resolves when the level-of-detail selection is made for the current view and exactly its
+   * chunks are shown, nothing pending.
+   */
   ready(timeoutMs?: number): Promise<void>;
   setCamera(lat: number, lon: number, altitude: number, headingDeg?: number, pitchDeg?: number): void;
   setPlanet(preset: string, seed: string | number): Promise<void>;
@@ -120,7 +147,17 @@ export interface PmcTestHook {
   path(): PmcPathHook;
   /** Turns the nav grid overlay on or off when `on` is given; returns its state. */
   navgrid(on?: boolean): PmcNavGridHook;
+  /** Sets the largest screen-space error (pixels) and the chunk budget when given; returns them. */
+  lod(settings?: Partial<LodSettings>): LodSettings;
 }
+
+/** The selection's settings (the panel's detail fields). */
+export interface LodSettings {
+  maxPixelError: number;
+  maxChunks: number;
+}
+
+export const DEFAULT_LOD: LodSettings = { maxPixelError: 2, maxChunks: 2500 };
 
 declare global {
   interface Window {
@@ -135,7 +172,7 @@ const STEP_CLIMB = 1.5;
 export class App {
   private readonly api = new PmcApi('api/v1');
   private readonly renderer: THREE.WebGLRenderer;
-  private readonly camera = new THREE.PerspectiveCamera(FOV, 1, 0.1, 1e5);
+  private readonly camera = new THREE.PerspectiveCamera(FOV, 1, 0.05, 1e5);
   private readonly scene = new PlanetScene();
   private readonly navScene = new NavScene();
   private readonly pathTool: PathTool;
@@ -148,6 +185,15 @@ export class App {
   /** The world revision the path and the grid were last asked for. */
   private navRevision = 0;
   private readonly streamer: ChunkStreamer;
+  private readonly selector: LodSelector;
+  private lodPlanet: LodPlanet | null = null;
+  private levelZeroOnly = false;
+  private lodSettings: LodSettings = { ...DEFAULT_LOD };
+  /** The view of the last selection asked for, and of the previous frame. */
+  private selectedView: ViewState | null = null;
+  private lastView: ViewState | null = null;
+  private lastSelectAt = -Infinity;
+  private selectMs = 0;
   private readonly ui: Ui;
   private readonly toolsUi: ToolsUi;
   private readonly editor: EditSession;
@@ -156,7 +202,6 @@ export class App {
   private readonly raycaster = new THREE.Raycaster();
   private readonly frustum = new THREE.Frustum();
   private readonly projView = new THREE.Matrix4();
-  private readonly tmpSphere = new THREE.Sphere();
 
   private params: PlanetParams | null = null;
   private choice: { preset?: string; seed?: string } = {};
@@ -185,18 +230,32 @@ export class App {
   private cameraPos: V3 = [0, 0, 0];
 
   constructor(private readonly canvas: HTMLCanvasElement) {
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, powerPreference: 'high-performance' });
+    // a logarithmic depth buffer: the same relative depth precision from 5 cm to the far side of
+    // an Earth-sized planet, with no near/far juggling
+    this.renderer = new THREE.WebGLRenderer({
+      canvas,
+      antialias: true,
+      powerPreference: 'high-performance',
+      logarithmicDepthBuffer: true,
+    });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.renderer.outputColorSpace = THREE.SRGBColorSpace;
     this.camera.position.set(0, 0, 0);
     this.camera.matrixAutoUpdate = false;
 
     this.streamer = new ChunkStreamer(this.api, {
-      onLoad: (key, chunk, bounds) => this.scene.addChunk(key, chunk, bounds),
-      onUnload: (key) => this.scene.removeChunk(key),
+      onShow: (name, seams, chunk) => this.scene.addChunk(name, seams, chunk),
+      onHide: (name) => this.scene.removeChunk(name),
       onError: (message) => this.showError(message),
       onRecovered: () => this.clearError(),
     });
+    this.selector = new LodSelector(
+      typeof Worker === 'function'
+        ? () => new Worker(new URL('./lod/worker.ts', import.meta.url), { type: 'module', name: 'pmc-lod' })
+        : null,
+      (r) => this.onSelection(r),
+      (message) => this.showError(message),
+    );
     this.ui = new Ui({
       onPlanet: (preset, seed) => void this.setPlanet(preset, seed).catch(() => undefined),
       onMode: (mode) => this.setMode(mode),
@@ -206,6 +265,7 @@ export class App {
         this.ui.setDebug(this.scene.debug());
       },
       onNavGrid: (on) => this.setNavGrid(on),
+      onLod: (settings) => this.setLod(settings),
     });
     this.scene.scene.add(this.navScene.group);
     this.pathTool = new PathTool({
@@ -257,6 +317,7 @@ export class App {
     this.choice = { ...(fromHash.preset ? { preset: fromHash.preset } : {}), ...(fromHash.seed ? { seed: fromHash.seed } : {}) };
     this.ui.setMode(this.mode, this.walk);
     this.ui.setDebug(this.scene.debug());
+    this.ui.setLod(this.lodSettings);
     window.__pmc = this.testHook();
     this.renderer.setAnimationLoop(() => this.frame());
     void this.loadPlanet(this.choice, true);
@@ -294,7 +355,13 @@ export class App {
   private applyPlanet(info: PlanetInfo): void {
     this.params = planetParams(info);
     this.choice = { preset: info.preset, seed: info.seed };
-    this.streamer.setPlanet(this.choice);
+    const lod = lodPlanetOf(info);
+    this.lodPlanet = lod.planet;
+    this.levelZeroOnly = lod.levelZeroOnly;
+    this.streamer.setPlanet(this.choice, lod.planet);
+    this.selector.setPlanet({ layout: info.layout, errors: lod.planet.errors, occluder: lod.planet.occluder });
+    this.selectedView = null;
+    this.lastView = null;
     this.editor.setPlanet(info);
     this.pathTool.setPlanet(this.params.shape.datum);
     this.navLoader.reset();
@@ -632,6 +699,72 @@ export class App {
     return { ...st, drawn: this.navScene.gridShown(), onScreen, visible };
   }
 
+  // ---- level of detail ------------------------------------------------------------------------
+
+  /** The selection's input for the camera of this frame (planet frame, f64). */
+  private viewState(pos: V3, forward: V3, up: V3): ViewState {
+    const planes: Plane[] = this.frustum.planes.map((p) => [p.normal.x, p.normal.y, p.normal.z, p.constant]);
+    const size = this.renderer.getDrawingBufferSize(new THREE.Vector2());
+    const lod = this.lodPlanet;
+    const total = lod ? levelZeroCount(lod.layout) : 0;
+    return {
+      view: {
+        eye: [pos[0], pos[1], pos[2]],
+        frustum: planesToPlanetFrame(planes, pos),
+        viewportHeightPx: Math.max(1, size.y),
+        fovY: (this.camera.fov * Math.PI) / 180,
+      },
+      params: {
+        maxPixelError: this.lodSettings.maxPixelError,
+        finestLevel: 0,
+        // a server without levels of detail: every level-0 chunk, however many the budget allows
+        maxChunks: this.levelZeroOnly ? Math.max(this.lodSettings.maxChunks, total) : this.lodSettings.maxChunks,
+      },
+      forward,
+      up,
+    };
+  }
+
+  /**
+   * Starts a selection when the view differs from the last one selected for and no selection is
+   * running: at once when the camera has stopped (the same view as the frame before), else at most
+   * every 150 ms while it moves.
+   */
+  private maybeSelect(view: ViewState, now: number): void {
+    if (this.lodPlanet === null || this.planetBusy !== null || this.selector.busy) return;
+    if (this.selectedView !== null && sameView(view, this.selectedView)) return;
+    const still = this.lastView !== null && sameView(view, this.lastView);
+    if (!still && now - this.lastSelectAt < 150) return;
+    if (this.selector.request(view.view, view.params)) {
+      this.selectedView = view;
+      this.lastSelectAt = now;
+    }
+  }
+
+  private onSelection(r: SelectionResult): void {
+    this.selectMs = r.ms;
+    this.streamer.setSelection(r.selection, r.view);
+  }
+
+  /** The last selection was asked for the view of the last frame and has arrived. */
+  private selectionCurrent(): boolean {
+    return (
+      !this.selector.busy && this.selectedView !== null && this.lastView !== null && sameView(this.lastView, this.selectedView)
+    );
+  }
+
+  /** New selection settings: the next frame selects again. */
+  setLod(settings: Partial<LodSettings>): void {
+    const px = settings.maxPixelError ?? this.lodSettings.maxPixelError;
+    const budget = settings.maxChunks ?? this.lodSettings.maxChunks;
+    if (!(Number.isFinite(px) && px > 0) || !(Number.isInteger(budget) && budget >= 1)) {
+      throw new Error('the pixel error must be a number above 0 and the chunk budget a whole number of at least 1');
+    }
+    this.lodSettings = { maxPixelError: px, maxChunks: budget };
+    this.ui.setLod(this.lodSettings);
+    this.settledFrames = 0;
+  }
+
   // ---- frame loop ---------------------------------------------------------------------------
 
   private resize(): void {
@@ -644,10 +777,21 @@ export class App {
 
   /** Distance down to the loaded terrain from `from` (render space), or null without a hit. */
   private groundDistance(from: V3, up: V3, maxDistance: number): number | null {
-    this.raycaster.set(new THREE.Vector3(from[0], from[1], from[2]), new THREE.Vector3(-up[0], -up[1], -up[2]));
     this.raycaster.near = 0;
     this.raycaster.far = maxDistance;
-    const hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
+    const origin = new THREE.Vector3(from[0], from[1], from[2]);
+    const down = new THREE.Vector3(-up[0], -up[1], -up[2]);
+    this.raycaster.set(origin, down);
+    let hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
+    if (hits.length === 0) {
+      // A ray exactly along a chunk border (a face's centre line: chunks of every level meet
+      // there) can pass between the two chunks' triangles, whose float32 vertices are relative
+      // to different origins: tilt it by a microradian and try once more.
+      const side = Math.abs(up[1]) < 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0);
+      down.addScaledVector(side.cross(down).normalize(), 1e-6).normalize();
+      this.raycaster.set(origin, down);
+      hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
+    }
     return hits.length > 0 ? hits[0]!.distance : null;
   }
 
@@ -741,10 +885,12 @@ export class App {
     this.camera.matrix.copy(m);
     this.camera.matrixWorld.copy(m);
     this.camera.matrixWorldInverse.copy(m).invert();
+    // clip planes: with the logarithmic depth buffer only the far plane's order of magnitude
+    // matters for precision; near stays a few centimetres up to a tenth of the height above the
+    // highest terrain (or the ground measured below), far reaches past the horizon
     const r = length(pos);
-    const aboveTop = r - shape.outer;
-    const nearFromGround = this.aboveGround !== null ? this.aboveGround * 0.3 : Infinity;
-    this.camera.near = Math.max(0.05, Math.min(aboveTop > 0 ? aboveTop * 0.4 : 0.1, nearFromGround, 1e5));
+    const clearance = Math.max(r - shape.outer, this.aboveGround ?? 0);
+    this.camera.near = Math.min(1e4, Math.max(0.05, 0.1 * clearance));
     this.range = loadRange(r, params.extent, Math.max(4 * params.chunkWidth, 100));
     this.camera.far = Math.max(this.camera.near * 10, this.range * 1.05 + params.chunkWidth);
     this.camera.updateProjectionMatrix();
@@ -761,19 +907,18 @@ export class App {
     const enu = enuAt(pos);
     this.scene.setSun(normalize(addScaled(addScaled(enu.up, enu.east, 0.55), enu.north, 0.35)));
 
-    // streaming
+    // streaming: select for this view (when it changed), fetch and show
     this.projView.multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse);
     this.frustum.setFromProjectionMatrix(this.projView);
-    this.streamer.update(pos, this.range, (c, radius) => {
-      this.tmpSphere.center.set(c[0] - pos[0], c[1] - pos[1], c[2] - pos[2]);
-      this.tmpSphere.radius = radius;
-      return this.frustum.intersectsSphere(this.tmpSphere);
-    });
+    const view = this.viewState(pos, basis.forward, basis.up);
+    this.maybeSelect(view, now);
+    this.lastView = view;
+    this.streamer.update();
 
     this.renderer.render(this.scene.scene, this.camera);
 
     const st = this.streamer.stats();
-    const settled = this.planetBusy === null && this.streamer.settled(pos, this.range);
+    const settled = this.planetBusy === null && this.selectionCurrent() && this.streamer.settled();
     this.settledFrames = settled ? this.settledFrames + 1 : 0;
     if (this.settledFrames >= 2 && this.readyWaiters.length > 0) {
       const waiters = this.readyWaiters;
@@ -787,8 +932,10 @@ export class App {
       this.lastUiUpdate = now;
       this.ui.setStats({
         planet: `${this.choice.preset ?? '?'} · seed ${this.choice.seed ?? '?'}`,
-        chunks: st.loaded,
+        chunks: st.shown,
+        loaded: st.loaded,
         pending: st.pending,
+        levels: formatLevels(st.levels),
         triangles: st.triangles,
         fps: this.fps,
         lat: this.state.lat,
@@ -830,9 +977,14 @@ export class App {
 
   stats(): PmcStats {
     const st = this.streamer.stats();
+    const {
+      loaded: _l, pending: _p, missing: _m, triangles: _t, vertices: _v, requested: _r, failed: _f, stale: _s, reloading: _g, reloads: _d,
+      ...lod
+    } = st;
     return {
       preset: this.choice.preset ?? null,
       seed: this.choice.seed ?? null,
+      shown: st.shown,
       loaded: st.loaded,
       pending: st.pending,
       missing: st.missing,
@@ -854,7 +1006,16 @@ export class App {
       drawCalls: this.renderer.info.render.calls,
       ready: this.settledFrames >= 2,
       error: this.error,
-      loadedKeys: this.streamer.loadedKeys(),
+      loadedKeys: this.streamer.shownNames(),
+      lod: {
+        ...lod,
+        levelsText: formatLevels(st.levels),
+        ...this.lodSettings,
+        selectMs: this.selectMs,
+        selecting: this.selector.busy,
+        current: this.selectionCurrent(),
+        levelZeroOnly: this.levelZeroOnly,
+      },
       stale: st.stale,
       reloading: st.reloading,
       reloads: st.reloads,
@@ -906,8 +1067,31 @@ export class App {
         if (on !== undefined) this.setNavGrid(on);
         return this.navGridHook();
       },
+      lod: (settings) => {
+        if (settings) this.setLod(settings);
+        return { ...this.lodSettings };
+      },
     };
   }
+}
+
+/** The chunks of level 0 of a layout. */
+function levelZeroCount(layout: Layout): number {
+  return 6 * layout.chunksPerSide(0) ** 2 * layout.depthChunks(0);
+}
+
+/**
+ * The level-of-detail data of a planet: `/planet`'s `lod` block, or, from a server without one
+ * (every level 0 and nothing else), a table that refines everything to level 0.
+ */
+export function lodPlanetOf(info: PlanetInfo): { planet: LodPlanet; levelZeroOnly: boolean } {
+  const layout = new Layout(info.layout);
+  const lod = info.lod;
+  if (lod && lod.errors.length === layout.maxLevel() + 1) {
+    return { planet: { layout, errors: [...lod.errors], occluder: lod.occluder_radius }, levelZeroOnly: false };
+  }
+  const errors = Array.from({ length: layout.maxLevel() + 1 }, (_, l) => (l === 0 ? 0 : 1e30));
+  return { planet: { layout, errors, occluder: info.surface_bounds?.[0] ?? info.base_radius }, levelZeroOnly: true };
 }
 
 /** The path row of the stats panel. */

@@ -1,116 +1,210 @@
-// Which chunks to request and which to unload, given the camera. Pure: no three.js, no DOM.
+// What to show and what to fetch, given a level-of-detail selection (`lod/select.ts`) and the
+// chunks loaded so far. Pure: no three.js, no DOM, no network.
+//
+// The selection names the chunks wanted now (its drawn leaves, each with its seams mask). Until
+// they are all loaded, what is shown must still cover the view: a chunk being refined stays until
+// every wanted chunk below it has arrived, a chunk being coarsened is replaced by its parent only
+// once the parent is there, and a chunk whose seams changed keeps its old variant until the new one
+// arrives. `chooseDisplay` computes that set; the streamer (`chunkStreamer.ts`) keeps the state.
 
-import type { V3 } from './frames';
+import { sphereDistance, type BoundingSphere } from './lod/bounds';
+import { childrenOf, FACES, parentOf, type ChunkKey, type Layout, type Vec3 } from './lod/layout';
 
-export interface ChunkBounds {
-  key: string;
-  /** Bounding sphere centre, planet frame, metres (f64). */
-  center: V3;
-  radius: number;
+/** The API's name of a chunk: `face/level/i/j/k` with the face's name (`top/0/3/4/1`). */
+export function chunkName(key: ChunkKey): string {
+  return `${FACES[key.face]}/${key.level}/${key.i}/${key.j}/${key.k}`;
 }
 
-export interface SelectionInput {
-  /** Camera position, planet frame, f64. */
-  camera: V3;
-  /** Load range, metres: chunks whose bounding sphere comes within it are wanted. */
-  range: number;
-  /** Candidates, e.g. from `/api/v1/chunks` (any order). */
-  candidates: readonly ChunkBounds[];
-  /** Whether a bounding sphere touches the view frustum. */
-  inFrustum: (center: V3, radius: number) => boolean;
-  /** Chunks loaded now (with their bounds, to decide unloading). */
-  loaded: ReadonlyMap<string, ChunkBounds>;
-  /** Keys requested and not answered yet. */
-  pending: ReadonlySet<string> | ReadonlyMap<string, ChunkBounds>;
-  /** Keys not to request now (e.g. failed recently and waiting for a retry). */
-  blocked?: ReadonlySet<string>;
-  /** At most this many requests in flight (default 6). */
-  maxConcurrent?: number;
-  /** Unload beyond `range * unloadFactor` (default 1.25: hysteresis). */
-  unloadFactor?: number;
+/** The key a `face/level/i/j/k` name stands for, or null when it is not one. */
+export function parseChunkName(name: string): ChunkKey | null {
+  const m = /^([a-z]+)\/(\d+)\/(\d+)\/(\d+)\/(\d+)$/.exec(name);
+  if (!m) return null;
+  const face = (FACES as readonly string[]).indexOf(m[1]!);
+  if (face < 0) return null;
+  return { face, level: Number(m[2]), i: Number(m[3]), j: Number(m[4]), k: Number(m[5]) };
 }
 
-export interface Selection {
-  /** Keys to request now, most urgent first (at most `maxConcurrent - pending`). */
-  request: string[];
-  /** Loaded keys beyond the unload distance. */
-  unload: string[];
-  /** Pending keys beyond the unload distance (requests worth cancelling). */
-  cancel: string[];
-  /** Wanted chunks neither loaded nor pending (including those requested now). */
-  missing: number;
+/** One variant of a chunk: its name and the seams mask it was meshed with. */
+export const variantId = (name: string, seams: number): string => `${name}~${seams}`;
+
+/** A leaf of the selection, as the streamer keeps it. */
+export interface SelectedLeaf {
+  key: ChunkKey;
+  name: string;
+  /** Sides toward a coarser neighbour (the `seams` of the request). */
+  seams: number;
+  /** In the view (not culled by the frustum or the horizon): wanted. */
+  drawn: boolean;
 }
 
-export const DEFAULT_MAX_CONCURRENT = 6;
-export const DEFAULT_UNLOAD_FACTOR = 1.25;
-
-/** Distance from `p` to the sphere (0 inside it). */
-export function sphereDistance(p: V3, center: V3, radius: number): number {
-  const d = Math.hypot(center[0] - p[0], center[1] - p[1], center[2] - p[2]);
-  return Math.max(0, d - radius);
-}
-
-export function selectChunks(input: SelectionInput): Selection {
-  const max = input.maxConcurrent ?? DEFAULT_MAX_CONCURRENT;
-  const unloadRange = input.range * (input.unloadFactor ?? DEFAULT_UNLOAD_FACTOR);
-  const { camera, loaded, pending } = input;
-
-  const wanted: { key: string; distance: number; visible: boolean }[] = [];
-  for (const c of input.candidates) {
-    if (loaded.has(c.key) || pending.has(c.key)) continue;
-    const distance = sphereDistance(camera, c.center, c.radius);
-    if (distance > input.range) continue;
-    wanted.push({ key: c.key, distance, visible: input.inFrustum(c.center, c.radius) });
-  }
-  const missing = wanted.length;
-  const blocked = input.blocked;
-  const free = Math.max(0, max - pending.size);
-  const request: string[] = [];
-  if (free > 0) {
-    wanted.sort(
-      (a, b) =>
-        Number(b.visible) - Number(a.visible) ||
-        a.distance - b.distance ||
-        (a.key < b.key ? -1 : a.key > b.key ? 1 : 0),
-    );
-    for (const w of wanted) {
-      if (request.length >= free) break;
-      if (blocked?.has(w.key)) continue;
-      request.push(w.key);
+/** The names of every chunk strictly above some leaf: the split chunks of the selection. */
+export function splitChunks(leaves: Iterable<SelectedLeaf>, maxLevel: number): Set<string> {
+  const out = new Set<string>();
+  for (const l of leaves) {
+    for (let k = l.key; k.level < maxLevel; ) {
+      k = parentOf(k);
+      const name = chunkName(k);
+      if (out.has(name)) break;
+      out.add(name);
     }
   }
+  return out;
+}
 
-  const unload: string[] = [];
-  for (const [key, c] of loaded) {
-    if (sphereDistance(camera, c.center, c.radius) > unloadRange) unload.push(key);
-  }
-  const cancel: string[] = [];
-  if (pending instanceof Map) {
-    for (const [key, c] of pending as ReadonlyMap<string, ChunkBounds>) {
-      if (sphereDistance(camera, c.center, c.radius) > unloadRange) cancel.push(key);
-    }
-  }
-  return { request, unload, cancel, missing };
+export interface DisplayInput {
+  layout: Layout;
+  /** Every leaf of the selection by name. */
+  leaves: ReadonlyMap<string, SelectedLeaf>;
+  /** `splitChunks(leaves)`. */
+  split: ReadonlySet<string>;
+  /** The loaded variants (seams masks) of each loaded chunk. */
+  loaded: ReadonlyMap<string, ReadonlySet<number>>;
+  /** Whether some chunk strictly below `name` is loaded. */
+  loadedBelow(name: string): boolean;
+  /** The variant shown now of each chunk shown. */
+  shown: ReadonlyMap<string, number>;
+  /** Whether a chunk can be in the picture (its sphere in the frustum and above the horizon). */
+  visible(key: ChunkKey): boolean;
+}
+
+export interface DisplayChoice {
+  /** The variant to show of each chunk to show. No two of them overlap. */
+  show: Map<string, number>;
+  /** Every part of the view that the selection draws is covered. */
+  complete: boolean;
+  /** `show` is exactly the drawn leaves of the selection, each with its own seams. */
+  exact: boolean;
+}
+
+interface Part {
+  show: [string, number][];
+  complete: boolean;
+}
+
+const NOTHING_NEEDED: Part = { show: [], complete: true };
+const HOLE: Part = { show: [], complete: false };
+
+function join(parts: Part[]): Part {
+  return { show: parts.flatMap((p) => p.show), complete: parts.every((p) => p.complete) };
 }
 
 /**
- * Whether the chunk list must be fetched again: never fetched, or the camera moved more than
- * `fraction` of the range since, or the range changed by more than `fraction` of itself.
+ * The chunks to show: each drawn leaf when it is loaded (its wanted variant, else the variant shown
+ * now, else another loaded one); where a leaf is missing, the loaded chunks below it that cover it
+ * (the finer chunks being coarsened stay), else the nearest loaded chunk above it (the chunk being
+ * refined stays until every wanted chunk below it is there). Never two overlapping chunks; a part
+ * of the view is left empty only when nothing loaded covers it.
  */
-export function needsRequery(
-  last: { camera: V3; range: number } | null,
-  camera: V3,
-  range: number,
-  fraction = 0.25,
-): boolean {
-  if (!last) return true;
-  const moved = Math.hypot(
-    camera[0] - last.camera[0],
-    camera[1] - last.camera[1],
-    camera[2] - last.camera[2],
-  );
-  if (moved > fraction * last.range) return true;
-  return Math.abs(range - last.range) > fraction * last.range;
+export function chooseDisplay(input: DisplayInput): DisplayChoice {
+  const { layout, leaves, split, loaded, shown } = input;
+  const maxLevel = layout.maxLevel();
+
+  const variantOf = (name: string, wanted: number | null): number | null => {
+    const set = loaded.get(name);
+    if (set === undefined || set.size === 0) return null;
+    if (wanted !== null && set.has(wanted)) return wanted;
+    const now = shown.get(name);
+    if (now !== undefined && set.has(now)) return now;
+    return Math.min(...set);
+  };
+
+  const existing = (key: ChunkKey): ChunkKey[] => childrenOf(key).filter((c) => layout.containsChunk(c));
+
+  // the region of `key`, a chunk below the selection's leaves or one of them, from loaded chunks
+  // at or below it: what is shown stays; else the finest complete cover; else `key` itself
+  const below = (key: ChunkKey): Part => {
+    const parts = existing(key).map((c): Part => {
+      const name = chunkName(c);
+      const v = variantOf(name, null);
+      if (v !== null && shown.has(name)) return { show: [[name, v]], complete: true };
+      if (input.loadedBelow(name)) {
+        const finer = below(c);
+        if (finer.complete || v === null) return finer;
+      }
+      if (v !== null) return { show: [[name, v]], complete: true };
+      return input.visible(c) ? HOLE : NOTHING_NEEDED;
+    });
+    return join(parts);
+  };
+
+  const cover = (key: ChunkKey, name: string): Part => {
+    const leaf = leaves.get(name);
+    if (leaf !== undefined) {
+      if (!leaf.drawn) return NOTHING_NEEDED;
+      const v = variantOf(name, leaf.seams);
+      if (v !== null) return { show: [[name, v]], complete: true };
+      return input.loadedBelow(name) ? below(key) : HOLE;
+    }
+    if (!split.has(name)) return NOTHING_NEEDED;
+    const inner = join(existing(key).map((c) => cover(c, chunkName(c))));
+    if (inner.complete) return inner;
+    const v = variantOf(name, null);
+    return v !== null ? { show: [[name, v]], complete: true } : inner;
+  };
+
+  const show = new Map<string, number>();
+  let complete = true;
+  for (const root of layout.chunks(maxLevel)) {
+    const part = cover(root, chunkName(root));
+    complete &&= part.complete;
+    for (const [name, v] of part.show) show.set(name, v);
+  }
+  let drawn = 0;
+  let exact = true;
+  for (const leaf of leaves.values()) {
+    if (!leaf.drawn) continue;
+    drawn++;
+    if (show.get(leaf.name) !== leaf.seams) exact = false;
+  }
+  if (show.size !== drawn) exact = false;
+  return { show, complete, exact };
+}
+
+/** The ratio of pixels to metres at unit distance: `h / (2 tan(fov / 2))`. */
+export function pixelScale(viewportHeightPx: number, fovY: number): number {
+  return viewportHeightPx / (2 * Math.tan(fovY / 2));
+}
+
+/** Added to the priority of a chunk whose place shows nothing yet: holes are filled first. */
+export const HOLE_PRIORITY = 1e6;
+
+/**
+ * The priority of fetching a wanted chunk (larger first, sent to the server as `priority`): the
+ * screen-space error in pixels that showing it removes, `errors[L + 1] h / (2 tan(fov / 2) d)` with
+ * `d` the distance from the eye to its sphere (the error of its parent's level, the level it
+ * replaces; for the coarsest level its own), capped at `HOLE_PRIORITY`, plus `HOLE_PRIORITY` when
+ * nothing covers its place yet. Rounded to hundredths.
+ */
+export function fetchPriority(
+  level: number,
+  errors: readonly number[],
+  sphere: BoundingSphere,
+  eye: Vec3,
+  scale: number,
+  hole: boolean,
+): number {
+  const e = errors[Math.min(level + 1, errors.length - 1)] ?? 0;
+  const d = sphereDistance(sphere, eye);
+  const px = d > 0 ? Math.min(HOLE_PRIORITY, (e * scale) / d) : e > 0 ? HOLE_PRIORITY : 0;
+  return Math.round(100 * (px + (hole ? HOLE_PRIORITY : 0))) / 100;
+}
+
+/** How many of `names` are at each level (index = level), e.g. `[12, 40, 18]`. */
+export function levelHistogram(names: Iterable<string>): number[] {
+  const out: number[] = [];
+  for (const name of names) {
+    const level = Number(name.split('/')[1]);
+    if (!Number.isInteger(level) || level < 0) continue;
+    while (out.length <= level) out.push(0);
+    out[level]!++;
+  }
+  return out;
+}
+
+/** The histogram as the stats panel shows it: `L0 12 · L1 40 · L2 18` (empty levels left out). */
+export function formatLevels(histogram: readonly number[]): string {
+  const parts = histogram.flatMap((n, level) => (n > 0 ? [`L${level} ${n}`] : []));
+  return parts.length > 0 ? parts.join(' · ') : '–';
 }
 
 export interface PlanetExtent {
@@ -121,9 +215,9 @@ export interface PlanetExtent {
 }
 
 /**
- * The load range for a camera `cameraRadius` metres from the centre: up to the horizon of the
- * lowest visible surface plus the distance behind it from which the highest terrain can still
- * stick out, at least `minRange`, at most `maxRange`.
+ * How far the camera can see terrain from `cameraRadius` metres from the centre: up to the horizon
+ * of the lowest visible surface plus the distance behind it from which the highest terrain can
+ * still stick out; at least `minRange`, at most `maxRange`. The far clipping plane.
  */
 export function loadRange(
   cameraRadius: number,

@@ -5,7 +5,6 @@
 
 import * as THREE from 'three';
 import type { DecodedChunk } from './chunkDecode';
-import type { ChunkBounds } from './chunkSelection';
 import { boundaryEdges } from './boundaryEdges';
 import { modPositive, relativeToCamera, type V3 } from './frames';
 import type { PlanetParams } from './planetParams';
@@ -29,6 +28,8 @@ const SPACE_BACKGROUND = new THREE.Color(0.004, 0.006, 0.012);
 
 interface ChunkObject {
   key: string;
+  /** The seams mask of the variant shown. */
+  seams: number;
   origin: V3;
   face: number;
   mesh: THREE.Mesh<THREE.BufferGeometry, THREE.ShaderMaterial>;
@@ -40,6 +41,11 @@ export interface DebugFlags {
   wireframe: boolean;
   faceColours: boolean;
   borders: boolean;
+  /**
+   * Test mode: back faces drawn in pure magenta (#ff00ff), no sea. From outside a closed surface no
+   * back face can be seen, so a magenta pixel is a crack or a hole.
+   */
+  backfaces: boolean;
 }
 
 export class PlanetScene {
@@ -61,9 +67,10 @@ export class PlanetScene {
     uNoiseFreq: { value: 0.01 },
     uSkyColour: { value: new THREE.Vector3(SKY_COLOUR.r, SKY_COLOUR.g, SKY_COLOUR.b) },
     uFogDistance: { value: 10000 },
+    uBackfaceFlag: { value: 0 },
   };
   private params: PlanetParams | null = null;
-  private flags: DebugFlags = { wireframe: false, faceColours: false, borders: false };
+  private flags: DebugFlags = { wireframe: false, faceColours: false, borders: false, backfaces: false };
   private readonly borderMaterial = new THREE.LineBasicMaterial({
     color: 0xffee33,
     depthTest: true,
@@ -170,6 +177,7 @@ export class PlanetScene {
       this.sea.frustumCulled = false;
       this.sea.renderOrder = 10; // after the terrain
       this.sea.matrixAutoUpdate = true;
+      this.sea.visible = !this.flags.backfaces;
       this.scene.add(this.sea);
     }
   }
@@ -189,7 +197,8 @@ export class PlanetScene {
     this.shared.uSunDir.value.set(dir[0], dir[1], dir[2]).normalize();
   }
 
-  addChunk(key: string, chunk: DecodedChunk, bounds: ChunkBounds): void {
+  /** Shows variant `seams` of chunk `key`, replacing the one shown; an empty chunk shows nothing. */
+  addChunk(key: string, seams: number, chunk: DecodedChunk): void {
     this.removeChunk(key);
     if (chunk.indexCount === 0 || !this.params) return;
     const g = new THREE.BufferGeometry();
@@ -201,9 +210,8 @@ export class PlanetScene {
     g.setAttribute('aMaterial', new THREE.BufferAttribute(chunk.materials, 1));
     g.setIndex(new THREE.BufferAttribute(chunk.indices, 1));
     const origin = chunk.origin;
-    // the API's bounding sphere, relative to the chunk origin (f64 subtraction first)
-    const c = relativeToCamera(bounds.center, origin);
-    g.boundingSphere = new THREE.Sphere(new THREE.Vector3(c[0], c[1], c[2]), bounds.radius);
+    // bounds of the vertices, relative to the chunk origin (for three.js's frustum culling)
+    g.computeBoundingSphere();
     g.computeBoundingBox();
 
     const period = this.params.noisePeriod;
@@ -223,6 +231,8 @@ export class PlanetScene {
         uFaceColour: { value: new THREE.Vector3(...(FACE_COLOURS[chunk.face] ?? [1, 1, 1])) },
       },
       wireframe: this.flags.wireframe,
+      // with the back-face flag on, faces seen from inside the solid are drawn (in magenta)
+      side: this.flags.backfaces ? THREE.DoubleSide : THREE.FrontSide,
     });
     if (this.flags.borders) {
       material.polygonOffset = true;
@@ -231,10 +241,13 @@ export class PlanetScene {
     }
     const mesh = new THREE.Mesh(g, material);
     mesh.name = key;
+    mesh.userData['seams'] = seams;
+    mesh.userData['level'] = chunk.level;
     mesh.frustumCulled = true;
     mesh.matrixAutoUpdate = true;
     const obj: ChunkObject = {
       key,
+      seams,
       origin,
       face: chunk.face,
       mesh,
@@ -284,9 +297,12 @@ export class PlanetScene {
     const bordersChanged = next.borders !== this.flags.borders;
     this.flags = next;
     this.shared.uDebugFace.value = next.faceColours ? 1 : 0;
+    this.shared.uBackfaceFlag.value = next.backfaces ? 1 : 0;
+    if (this.sea) this.sea.visible = !next.backfaces;
     for (const obj of this.chunks.values()) {
       const m = obj.mesh.material;
       m.wireframe = next.wireframe;
+      m.side = next.backfaces ? THREE.DoubleSide : THREE.FrontSide;
       m.polygonOffset = next.borders;
       m.polygonOffsetFactor = 1;
       m.polygonOffsetUnits = 1;
@@ -346,6 +362,11 @@ export class PlanetScene {
 
   chunkCount(): number {
     return this.chunks.size;
+  }
+
+  /** The variant shown of chunk `key` (its seams mask), or undefined when none is drawn. */
+  shownSeams(key: string): number | undefined {
+    return this.chunks.get(key)?.seams;
   }
 
   triangleCount(): number {

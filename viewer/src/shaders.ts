@@ -87,6 +87,7 @@ uniform float uDebugFace;
 uniform vec3 uFaceColour;
 uniform vec3 uSkyColour;
 uniform float uFogDistance;
+uniform float uBackfaceFlag; // test mode: back faces (the inside of the solid) in pure magenta
 varying vec3 vColor;
 varying float vHeight;
 varying float vWater;
@@ -99,6 +100,15 @@ varying vec3 vRel;
 ${NOISE}
 void main() {
   #include <logdepthbuf_fragment>
+  if (uBackfaceFlag > 0.5 && !gl_FrontFacing) {
+    #ifdef USE_LOGDEPTHBUF
+    // 0.2 % farther: where a back face meets a front face at a silhouette (the same edge, the
+    // same depth) the front face wins; the inside seen through a crack is far behind anyway
+    gl_FragDepth = min(1.0, gl_FragDepth + log2(1.002) * logDepthBufFC * 0.5);
+    #endif
+    gl_FragColor = vec4(1.0, 0.0, 1.0, 1.0);
+    return;
+  }
   vec3 n = normalize(vNormal);
   vec3 up = normalize(vUp);
   float noise = pmcFbm(vNoisePos);

@@ -13,12 +13,18 @@ export interface UiCallbacks {
   onDebug(flags: Partial<DebugFlags>): void;
   /** The nav grid checkbox. */
   onNavGrid(on: boolean): void;
+  /** The detail fields: largest screen-space error in pixels, chunk budget. */
+  onLod(settings: { maxPixelError?: number; maxChunks?: number }): void;
 }
 
 export interface StatsView {
   planet: string;
+  /** Chunks shown, and loaded (shown or kept). */
   chunks: number;
+  loaded: number;
   pending: number;
+  /** Chunks shown per level, e.g. `L0 12 · L1 40 · L2 18`. */
+  levels: string;
   triangles: number;
   fps: number;
   lat: number;
@@ -52,6 +58,9 @@ export class Ui {
   private readonly wireframe = byId<HTMLInputElement>('wireframe');
   private readonly faces = byId<HTMLInputElement>('faces');
   private readonly borders = byId<HTMLInputElement>('borders');
+  private readonly backfaces = byId<HTMLInputElement>('backfaces');
+  private readonly pixelError = byId<HTMLInputElement>('lod-px');
+  private readonly budget = byId<HTMLInputElement>('lod-budget');
   private readonly navgrid = byId<HTMLInputElement>('navgrid');
   private readonly navgridStatus = byId<HTMLParagraphElement>('navgrid-status');
   private shownNavGrid = '';
@@ -62,7 +71,9 @@ export class Ui {
   private readonly fields = {
     planet: byId('s-planet'),
     chunks: byId('s-chunks'),
+    loaded: byId('s-loaded'),
     pending: byId('s-pending'),
+    levels: byId('s-levels'),
     triangles: byId('s-triangles'),
     fps: byId('s-fps'),
     lat: byId('s-lat'),
@@ -97,6 +108,21 @@ export class Ui {
     this.borders.addEventListener('change', () =>
       this.callbacks.onDebug({ borders: this.borders.checked }),
     );
+    this.backfaces.addEventListener('change', () =>
+      this.callbacks.onDebug({ backfaces: this.backfaces.checked }),
+    );
+    const lodField = (input: HTMLInputElement, apply: (v: number) => void, valid: (v: number) => boolean): void => {
+      input.addEventListener('change', () => {
+        const v = Number(input.value);
+        if (input.value.trim() !== '' && valid(v)) {
+          apply(v);
+        } else {
+          this.showError(`"${input.value}" is not a valid ${input.getAttribute('aria-label') ?? 'value'}`);
+        }
+      });
+    };
+    lodField(this.pixelError, (v) => this.callbacks.onLod({ maxPixelError: v }), (v) => Number.isFinite(v) && v > 0);
+    lodField(this.budget, (v) => this.callbacks.onLod({ maxChunks: v }), (v) => Number.isInteger(v) && v >= 1);
     this.navgrid.addEventListener('change', () => {
       this.callbacks.onNavGrid(this.navgrid.checked);
       this.navgrid.blur();
@@ -146,6 +172,13 @@ export class Ui {
     this.wireframe.checked = flags.wireframe;
     this.faces.checked = flags.faceColours;
     this.borders.checked = flags.borders;
+    this.backfaces.checked = flags.backfaces;
+  }
+
+  /** The detail fields. */
+  setLod(s: { maxPixelError: number; maxChunks: number }): void {
+    if (document.activeElement !== this.pixelError) this.pixelError.value = String(s.maxPixelError);
+    if (document.activeElement !== this.budget) this.budget.value = String(s.maxChunks);
   }
 
   /**
@@ -238,7 +271,9 @@ export class Ui {
     const f = this.fields;
     f.planet.textContent = s.planet;
     f.chunks.textContent = fmtInt(s.chunks);
+    f.loaded.textContent = fmtInt(s.loaded);
     f.pending.textContent = fmtInt(s.pending);
+    f.levels.textContent = s.levels;
     f.triangles.textContent = fmtInt(s.triangles);
     f.fps.textContent = s.fps.toFixed(0);
     f.lat.textContent = `${Math.abs(s.lat).toFixed(4)}° ${s.lat >= 0 ? 'N' : 'S'}`;

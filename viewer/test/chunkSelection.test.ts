@@ -1,184 +1,146 @@
 import { describe, expect, it } from 'vitest';
 import {
+  chooseDisplay,
+  chunkName,
+  fetchPriority,
+  formatLevels,
+  HOLE_PRIORITY,
+  levelHistogram,
   loadRange,
-  needsRequery,
-  selectChunks,
-  sphereDistance,
-  type ChunkBounds,
+  parseChunkName,
+  splitChunks,
+  type SelectedLeaf,
 } from '../src/chunkSelection';
-import type { V3 } from '../src/frames';
+import { parentOf } from '../src/lod/layout';
+import type { LodSelection } from '../src/lod/select';
+import { LAYOUT, selection } from './lodFixture';
 
-// a row of chunks along +X, 10 m apart, radius 2: chunk n is at x = 10 n
-const row = (count: number): ChunkBounds[] =>
-  Array.from({ length: count }, (_, n) => ({ key: `c${n}`, center: [10 * n, 0, 0] as V3, radius: 2 }));
+const TOP = 'top/2/0/0/0';
 
-const everywhere = (): boolean => true;
-const none = new Map<string, ChunkBounds>();
-const noneSet = new Set<string>();
+/** The display for `sel` with these loaded variants (`name~seams`) and these shown ones. */
+function display(sel: LodSelection, loaded: string[], shown: string[] = [], visible: (name: string) => boolean = () => true) {
+  const leaves = new Map<string, SelectedLeaf>();
+  for (const c of sel.chunks) {
+    const name = chunkName(c.key);
+    leaves.set(name, { key: c.key, name, seams: c.coarser, drawn: c.drawn });
+  }
+  const variants = new Map<string, Set<number>>();
+  for (const v of loaded) {
+    const [name, seams] = v.split('~') as [string, string];
+    variants.set(name, new Set([...(variants.get(name) ?? []), Number(seams)]));
+  }
+  const below = new Set<string>();
+  for (const name of variants.keys()) {
+    for (let k = parseChunkName(name)!; k.level < LAYOUT.maxLevel(); ) {
+      k = parentOf(k);
+      below.add(chunkName(k));
+    }
+  }
+  const choice = chooseDisplay({
+    layout: LAYOUT,
+    leaves,
+    split: splitChunks(leaves.values(), LAYOUT.maxLevel()),
+    loaded: variants,
+    loadedBelow: (name) => below.has(name),
+    shown: new Map(shown.map((v) => v.split('~') as [string, string]).map(([n, s]) => [n, Number(s)])),
+    visible: (key) => visible(chunkName(key)),
+  });
+  return { ...choice, list: [...choice.show].map(([n, s]) => `${n}~${s}`).sort() };
+}
 
-describe('selectChunks', () => {
-  it('requests nearest first, within range', () => {
-    const sel = selectChunks({
-      camera: [25, 0, 0],
-      range: 100,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded: none,
-      pending: noneSet,
-      maxConcurrent: 20,
-    });
-    // distances to sphere: |10n - 25| - 2
-    expect(sel.request.slice(0, 4)).toEqual(['c2', 'c3', 'c1', 'c4']);
-    expect(sel.request).toHaveLength(10);
-    expect(sel.missing).toBe(10);
+const roots = ['top', 'bottom', 'north', 'south', 'east', 'west'].map((f) => `${f}/2/0/0/0~0`);
+const topKids = ['top/1/0/0/0', 'top/1/0/1/0', 'top/1/1/0/0', 'top/1/1/1/0'];
+
+describe('chunk names', () => {
+  it('name keys as the API does, and back', () => {
+    const key = { face: 4, level: 1, i: 3, j: 0, k: 12 };
+    expect(chunkName(key)).toBe('east/1/3/0/12');
+    expect(parseChunkName('east/1/3/0/12')).toEqual(key);
+    for (const bad of ['east/1/3/0', 'venus/0/0/0/0', 'top/0/0/0/-1', 'top/0/0/0/0~3']) expect(parseChunkName(bad)).toBeNull();
   });
 
-  it('leaves out chunks beyond the range', () => {
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 35,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded: none,
-      pending: noneSet,
-      maxConcurrent: 20,
-    });
-    // c3 at 30 - 2 = 28 is in, c4 at 38 is out
-    expect(sel.request).toEqual(['c0', 'c1', 'c2', 'c3']);
-  });
-
-  it('puts chunks in the view frustum first, nearest first among them', () => {
-    const inFrustum = (c: V3): boolean => c[0] >= 50; // looking toward +X far away
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 1000,
-      candidates: row(10),
-      inFrustum,
-      loaded: none,
-      pending: noneSet,
-      maxConcurrent: 6,
-    });
-    expect(sel.request).toEqual(['c5', 'c6', 'c7', 'c8', 'c9', 'c0']);
-  });
-
-  it('caps the requests in flight', () => {
-    const pending = new Set(['c0', 'c1', 'c2', 'c3']);
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 1000,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded: none,
-      pending,
-      maxConcurrent: 6,
-    });
-    expect(sel.request).toEqual(['c4', 'c5']); // 6 - 4 free slots, pending ones skipped
-    const full = selectChunks({
-      camera: [0, 0, 0],
-      range: 1000,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded: none,
-      pending: new Set(['c0', 'c1', 'c2', 'c3', 'c4', 'c5']),
-    });
-    expect(full.request).toEqual([]); // default cap is 6
-    expect(full.missing).toBe(4);
-  });
-
-  it('skips loaded and blocked chunks', () => {
-    const loaded = new Map(row(3).map((c) => [c.key, c]));
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 1000,
-      candidates: row(6),
-      inFrustum: everywhere,
-      loaded,
-      pending: noneSet,
-      blocked: new Set(['c3']),
-    });
-    expect(sel.request).toEqual(['c4', 'c5']);
-    expect(sel.missing).toBe(3); // c3 is still missing
-  });
-
-  it('unloads only beyond range x 1.25 (hysteresis)', () => {
-    const loaded = new Map(row(10).map((c) => [c.key, c]));
-    // range 40: loaded while within 40, unloaded beyond 50 (to the sphere)
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 40,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded,
-      pending: noneSet,
-    });
-    // c5: 48 (kept, inside 50), c6: 58 (unloaded)
-    expect(sel.unload).toEqual(['c6', 'c7', 'c8', 'c9']);
-    expect(sel.request).toEqual([]);
-    // a chunk that has just left the load range is not dropped
-    const sel2 = selectChunks({
-      camera: [-5, 0, 0],
-      range: 40,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded: new Map([['c4', row(10)[4]!]]),
-      pending: noneSet,
-      unloadFactor: 1.25,
-    });
-    expect(sel2.unload).toEqual([]);
-  });
-
-  it('cancels pending requests beyond the unload distance', () => {
-    const pending = new Map(row(10).map((c) => [c.key, c]));
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 40,
-      candidates: row(10),
-      inFrustum: everywhere,
-      loaded: none,
-      pending,
-    });
-    expect(sel.cancel).toEqual(['c6', 'c7', 'c8', 'c9']);
-  });
-
-  it('ordering is deterministic for equal distances', () => {
-    const cands: ChunkBounds[] = [
-      { key: 'b', center: [10, 0, 0], radius: 1 },
-      { key: 'a', center: [-10, 0, 0], radius: 1 },
-      { key: 'c', center: [0, 10, 0], radius: 1 },
-    ];
-    const sel = selectChunks({
-      camera: [0, 0, 0],
-      range: 100,
-      candidates: cands,
-      inFrustum: everywhere,
-      loaded: none,
-      pending: noneSet,
-    });
-    expect(sel.request).toEqual(['a', 'b', 'c']);
+  it('lists the split chunks of a selection', () => {
+    const sel = selection([TOP, 'top/1/0/0/0']);
+    const leaves = sel.chunks.map((c) => ({ key: c.key, name: chunkName(c.key), seams: 0, drawn: true }));
+    expect([...splitChunks(leaves, LAYOUT.maxLevel())].sort()).toEqual(['top/1/0/0/0', TOP]);
   });
 });
 
-describe('sphereDistance', () => {
-  it('is 0 inside the sphere', () => {
-    expect(sphereDistance([0, 0, 0], [1, 0, 0], 2)).toBe(0);
-    expect(sphereDistance([0, 0, 0], [5, 0, 0], 2)).toBe(3);
+describe('chooseDisplay', () => {
+  it('shows exactly the wanted variants once they are loaded', () => {
+    const d = display(selection([TOP], { 'top/1/0/0/0': 3 }), [...roots, ...topKids.map((k) => `${k}~0`), 'top/1/0/0/0~3']);
+    expect(d.list).toEqual([...roots.filter((r) => !r.startsWith('top')), 'top/1/0/0/0~3', ...topKids.slice(1).map((k) => `${k}~0`)].sort());
+    expect(d).toMatchObject({ exact: true, complete: true });
+  });
+
+  it('keeps the chunk being refined while a wanted child is missing, and does not show the others', () => {
+    const d = display(selection([TOP]), [...roots, 'top/1/0/0/0~0', 'top/1/0/1/0~0', 'top/1/1/0/0~0'], roots);
+    expect(d.list).toEqual([...roots].sort());
+    expect(d).toMatchObject({ exact: false, complete: true });
+  });
+
+  it('does not wait for a child that is not drawn', () => {
+    const d = display(selection([TOP], {}, ['top/1/1/1/0']), [...roots, 'top/1/0/0/0~0', 'top/1/0/1/0~0', 'top/1/1/0/0~0'], roots);
+    expect(d.list).toContain('top/1/0/0/0~0');
+    expect(d.list).not.toContain(`${TOP}~0`);
+    expect(d).toMatchObject({ exact: true, complete: true });
+  });
+
+  it('keeps the children of a chunk being coarsened until it is loaded', () => {
+    const kids = topKids.map((k) => `${k}~0`);
+    const d = display(selection(), [...roots.slice(1), ...kids], [...roots.slice(1), ...kids]);
+    expect(d.list).toEqual([...roots.slice(1), ...kids].sort());
+    expect(d).toMatchObject({ exact: false, complete: true });
+    // a child missing whose place is out of the view is not needed
+    const out = display(selection(), [...roots.slice(1), ...kids.slice(1)], [...roots.slice(1), ...kids.slice(1)], (n) => n !== 'top/1/0/0/0');
+    expect(out.list).toEqual([...roots.slice(1), ...kids.slice(1)].sort());
+    expect(out.complete).toBe(true);
+    // one in the view: the place is not covered
+    const hole = display(selection(), [...roots.slice(1), ...kids.slice(1)], [...roots.slice(1), ...kids.slice(1)]);
+    expect(hole.complete).toBe(false);
+  });
+
+  it('keeps the variant shown until the wanted one is loaded, else takes any loaded one', () => {
+    const sel = selection([TOP], { 'top/1/0/0/0': 5 });
+    const loaded = [...roots, ...topKids.map((k) => `${k}~0`), 'top/1/0/0/0~1'];
+    expect(display(sel, loaded, ['top/1/0/0/0~1']).list).toContain('top/1/0/0/0~1');
+    expect(display(sel, loaded, ['top/1/0/0/0~0']).list).toContain('top/1/0/0/0~0');
+    expect(display(sel, [...loaded, 'top/1/0/0/0~5'], ['top/1/0/0/0~0']).list).toContain('top/1/0/0/0~5');
+  });
+
+  it('takes a coarser chunk from the cache over a hole two levels up, and shows what it can with nothing above', () => {
+    const sel = selection([TOP, 'top/1/0/0/0']);
+    // the level-1 chunk is loaded, not its four children: it stands in for them
+    const d = display(sel, [...roots, ...topKids.map((k) => `${k}~0`)]);
+    expect(d.list).toContain('top/1/0/0/0~0');
+    expect(d.list.filter((n) => n.startsWith('top/0/'))).toEqual([]);
+    expect(d.complete).toBe(true);
+    // nothing above the missing ones: the loaded siblings are shown, the place stays open
+    const partial = display(sel, ['top/0/0/0/0~0', 'top/0/1/1/0~0', 'top/1/0/1/0~0']);
+    expect(partial.list).toEqual(['top/0/0/0/0~0', 'top/0/1/1/0~0', 'top/1/0/1/0~0']);
+    expect(partial.complete).toBe(false);
   });
 });
 
-describe('needsRequery', () => {
-  it('re-queries the first time and after moving a fraction of the range', () => {
-    expect(needsRequery(null, [0, 0, 0], 100)).toBe(true);
-    const last = { camera: [0, 0, 0] as V3, range: 100 };
-    expect(needsRequery(last, [24, 0, 0], 100)).toBe(false);
-    expect(needsRequery(last, [26, 0, 0], 100)).toBe(true);
-    expect(needsRequery(last, [0, 0, 10], 100, 0.05)).toBe(true);
+describe('fetchPriority and the level histogram', () => {
+  const sphere = { center: [0, 100, 0] as [number, number, number], radius: 10 };
+  it('is the pixel error of the level replaced, plus a bonus for a hole', () => {
+    // 40 m from the sphere, the level-1 error (1 m) at 600 px per radian-ish scale
+    expect(fetchPriority(0, [0, 1, 2], sphere, [0, 150, 0], 600, false)).toBe(15);
+    expect(fetchPriority(1, [0, 1, 2], sphere, [0, 150, 0], 600, false)).toBe(30);
+    expect(fetchPriority(2, [0, 1, 2], sphere, [0, 150, 0], 600, false)).toBe(30);
+    expect(fetchPriority(0, [0, 1, 2], sphere, [0, 150, 0], 600, true)).toBe(HOLE_PRIORITY + 15);
+    // inside the sphere: as urgent as it gets without being a hole
+    expect(fetchPriority(0, [0, 1, 2], sphere, [0, 100, 0], 600, false)).toBe(HOLE_PRIORITY);
+    // nearer is more urgent
+    expect(fetchPriority(0, [0, 1, 2], sphere, [0, 120, 0], 600, false)).toBeGreaterThan(15);
   });
 
-  it('re-queries when the range changes a lot', () => {
-    const last = { camera: [0, 0, 0] as V3, range: 100 };
-    expect(needsRequery(last, [0, 0, 0], 120)).toBe(false);
-    expect(needsRequery(last, [0, 0, 0], 130)).toBe(true);
-    expect(needsRequery(last, [0, 0, 0], 70)).toBe(true);
+  it('counts the chunks shown per level', () => {
+    const h = levelHistogram(['top/0/0/0/0', 'top/0/1/0/0', 'top/2/0/0/0', 'bottom/0/0/0/0']);
+    expect(h).toEqual([3, 0, 1]);
+    expect(formatLevels(h)).toBe('L0 3 · L2 1');
+    expect(formatLevels([])).toBe('–');
   });
 });
 
@@ -195,5 +157,11 @@ describe('loadRange', () => {
   });
   it('grows with altitude', () => {
     expect(loadRange(2500, extent, 1)).toBeGreaterThan(loadRange(2000, extent, 1));
+  });
+  it('reaches past the horizon at Earth radius, 2 m above the sea', () => {
+    const earth = { innerRadius: 6371000, outerRadius: 6384108 };
+    const far = loadRange(6371002, earth, 100);
+    expect(far).toBeGreaterThan(400_000); // the highest mountains behind the horizon
+    expect(far).toBeLessThan(420_000);
   });
 });

@@ -1,209 +1,153 @@
 import { describe, expect, it } from 'vitest';
-import { ApiError, PmcApi, type ChunkEntry, type PlanetInfo } from '../src/api';
-import type { DecodedChunk } from '../src/chunkDecode';
-import { ChunkStreamer } from '../src/chunkStreamer';
+import { ApiError, PmcApi, type PlanetInfo } from '../src/api';
 import { EditSession, editErrorMessage } from '../src/editSession';
 import type { EventSourceLike } from '../src/editEvents';
-import type { V3 } from '../src/frames';
-import { encodeChunk } from './encodeChunk';
+import { chunkServer, selection, streamerOn, tick, VIEW } from './lodFixture';
 
-const tick = (): Promise<void> => new Promise((r) => setTimeout(r, 0));
-const all = (): boolean => true;
+const TOP = 'top/2/0/0/0';
 
-/**
- * A server whose chunk answers are held until the test releases them. Each chunk's mesh has as
- * many triangles as the chunk's current "version" (bumped by `edit`), so a test can tell which
- * version an answer carries.
- */
-function heldServer(count = 3) {
-  const version = new Map<string, number>();
-  const waiting: { key: string; version: number; resolve: (r: Response) => void }[] = [];
-  const chunkRequests: string[] = [];
-  const entries: ChunkEntry[] = Array.from({ length: count }, (_, n) => ({
-    key: `top/0/${n}/0/0`, face: 'top', level: 0, i: n, j: 0, k: 0, center: [10 * n, 0, 0], radius: 2, distance: 0,
-  }));
-  const body = (key: string, v: number): Uint8Array<ArrayBuffer> => {
-    const i = Number(key.split('/')[2]);
-    const positions: V3[] = [];
-    const indices: number[] = [];
-    for (let t = 0; t < v; t++) {
-      positions.push([t, 0, 0], [t + 1, 0, 0], [t, 1, 0]);
-      indices.push(3 * t, 3 * t + 1, 3 * t + 2);
-    }
-    return encodeChunk({ i, origin: [10 * i, 0, 0], positions, indices });
-  };
-  const fetchFn = (url: string, init?: RequestInit): Promise<Response> => {
-    const u = new URL(url, 'http://host/');
-    if (u.pathname === '/api/v1/chunks') {
-      return Promise.resolve(new Response(JSON.stringify({ chunks: entries, total_in_range: entries.length })));
-    }
-    const key = u.pathname.slice('/api/v1/chunk/'.length);
-    chunkRequests.push(key);
-    const v = version.get(key) ?? 1;
-    return new Promise((resolve, reject) => {
-      init?.signal?.addEventListener('abort', () => reject(new DOMException('aborted', 'AbortError')));
-      waiting.push({ key, version: v, resolve });
-    });
-  };
-  return {
-    fetchFn,
-    chunkRequests,
-    edit: (key: string) => version.set(key, (version.get(key) ?? 1) + 1),
-    /** Answers every held request with the data it was asked at (possibly out of date). */
-    releaseAll: async () => {
-      while (waiting.length > 0) {
-        const w = waiting.shift()!;
-        w.resolve(new Response(body(w.key, w.version)));
-      }
-      await tick();
-      await tick();
-    },
-    held: () => waiting.map((w) => w.key),
-  };
-}
-
-function streamerOn(server: ReturnType<typeof heldServer>) {
-  const shown = new Map<string, number>(); // key -> triangles shown
-  const log: string[] = [];
-  const s = new ChunkStreamer(new PmcApi('/api/v1', server.fetchFn), {
-    onLoad: (key, chunk: DecodedChunk) => {
-      shown.set(key, chunk.indexCount / 3);
-      log.push(`load ${key} v${chunk.indexCount / 3}`);
-    },
-    onUnload: (key) => {
-      shown.delete(key);
-      log.push(`unload ${key}`);
-    },
-    onError: (m) => log.push(`error ${m}`),
-  });
-  s.setPlanet({ preset: 'earthlike', seed: '7' });
-  const cam: V3 = [0, 0, 0];
-  const step = async (): Promise<void> => {
-    s.update(cam, 100, all);
-    await tick();
-  };
-  return { s, shown, log, step, cam };
+/** A streamer showing five roots and the four level-1 chunks of the top face, all loaded. */
+async function loadedStreamer(opts: { now?: () => number } = {}) {
+  const server = chunkServer();
+  const t = streamerOn(server, { maxConcurrent: 20, ...opts });
+  t.s.setSelection(selection([TOP]), VIEW);
+  await t.step();
+  await server.releaseAll();
+  await t.step();
+  expect(t.s.settled()).toBe(true);
+  return { server, ...t };
 }
 
 describe('reloading edited chunks', () => {
-  it('refetches a loaded chunk and swaps the mesh only when the new data arrives', async () => {
-    const server = heldServer();
-    const { s, shown, log, step, cam } = streamerOn(server);
-    await step();
-    await step();
-    await server.releaseAll();
-    await step();
-    expect([...shown.values()]).toEqual([1, 1, 1]);
-    expect(s.settled(cam, 100)).toBe(true);
-
-    server.edit('top/0/1/0/0');
-    expect(s.reload(['top/0/1/0/0', 'top/0/9/0/0'])).toBe(1); // a chunk not shown is ignored
-    expect(s.settled(cam, 100)).toBe(false);
+  it('refetches a chunk shown and swaps the mesh only when the new data arrives', async () => {
+    const { server, s, shown, log, step } = await loadedStreamer();
+    server.edit('top/1/0/0/0');
+    // an edit names chunks of every level: those not shown are ignored
+    expect(s.reload(['top/1/0/0/0', 'top/0/0/0/0', 'bottom/1/0/0/0'])).toBe(1);
+    expect(s.settled()).toBe(false);
     expect(s.stats().stale).toBe(1);
     await step();
-    expect(server.held()).toEqual(['top/0/1/0/0']);
+    expect(server.held()).toEqual(['top/1/0/0/0~0']);
     expect(s.stats().reloading).toBe(1);
     // meanwhile the old mesh stays
-    expect(shown.get('top/0/1/0/0')).toBe(1);
-    expect(log.filter((l) => l.startsWith('unload'))).toEqual([]);
+    expect(shown.get('top/1/0/0/0')!.triangles).toBe(1);
+    expect(log.filter((l) => l.startsWith('hide'))).toEqual([]);
     await server.releaseAll();
-    expect(shown.get('top/0/1/0/0')).toBe(2);
+    expect(shown.get('top/1/0/0/0')!.triangles).toBe(2);
     await step();
-    expect(s.settled(cam, 100)).toBe(true);
-    expect(s.stats()).toMatchObject({ loaded: 3, stale: 0, reloading: 0, reloads: 1, triangles: 4 });
-    expect(log.filter((l) => l.startsWith('unload'))).toEqual([]);
+    expect(s.settled()).toBe(true);
+    expect(s.stats()).toMatchObject({ shown: 9, stale: 0, reloading: 0, reloads: 1, triangles: 10 });
+  });
+
+  it('drops a loaded chunk not shown that an edit names, so that it is fetched fresh', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 20 });
+    for (const sel of [selection(), selection([TOP])]) {
+      s.setSelection(sel, VIEW);
+      await step();
+      await server.releaseAll();
+      await step();
+    }
+    // the top root is in the cache, not shown (its children are)
+    expect(shown.has(TOP)).toBe(false);
+    expect(s.stats().loaded).toBe(10);
+    server.edit(TOP);
+    expect(s.reload([TOP])).toBe(0);
+    expect(s.stats().loaded).toBe(9);
+    s.setSelection(selection(), VIEW);
+    await step();
+    // not shown from the stale cache: fetched again, the children stay meanwhile
+    expect(server.held()).toEqual([`${TOP}~0`]);
+    expect(shown.get(TOP)).toBeUndefined();
+    expect(shown.has('top/1/0/0/0')).toBe(true);
+    await server.releaseAll();
+    await step();
+    expect(shown.get(TOP)!.triangles).toBe(2);
+    expect(shown.has('top/1/0/0/0')).toBe(false);
+  });
+
+  it('reloads every seams variant of a chunk shown', async () => {
+    const { server, s, shown, step } = await loadedStreamer();
+    s.setSelection(selection([TOP], { 'top/1/0/0/0': 3 }), VIEW);
+    await step();
+    await server.releaseAll();
+    await step();
+    expect(shown.get('top/1/0/0/0')!.seams).toBe(3);
+    server.edit('top/1/0/0/0');
+    expect(s.reload(['top/1/0/0/0'])).toBe(1);
+    await step();
+    expect(server.held()).toEqual(['top/1/0/0/0~3']);
+    expect(s.stats().loaded).toBe(9); // the old variant (seams 0), not shown, was dropped
+    await server.releaseAll();
+    expect(shown.get('top/1/0/0/0')).toEqual({ seams: 3, triangles: 2 });
   });
 
   it('fetches again a chunk whose fetch was in flight when the edit named it', async () => {
-    const server = heldServer(1);
-    const { s, shown, step, cam } = streamerOn(server);
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 20 });
+    s.setSelection(selection(), VIEW);
     await step();
-    await step();
-    expect(server.held()).toEqual(['top/0/0/0/0']); // asked before the edit
-    server.edit('top/0/0/0/0');
-    expect(s.reload(['top/0/0/0/0'])).toBe(1);
+    expect(server.held()).toContain(`${TOP}~0`); // asked before the edit
+    server.edit(TOP);
+    expect(s.reload([TOP])).toBe(1);
     await server.releaseAll(); // the old answer arrives: shown (better than a hole)...
-    expect(shown.get('top/0/0/0/0')).toBe(1);
-    expect(s.settled(cam, 100)).toBe(false); // ...but not final
     await step();
-    expect(server.held()).toEqual(['top/0/0/0/0']);
+    expect(shown.get(TOP)!.triangles).toBe(1);
+    expect(s.settled()).toBe(false); // ...but not final
+    expect(server.held()).toEqual([`${TOP}~0`]);
     await server.releaseAll();
-    expect(shown.get('top/0/0/0/0')).toBe(2);
+    expect(shown.get(TOP)!.triangles).toBe(2);
     await step();
-    expect(s.settled(cam, 100)).toBe(true);
-    expect(server.chunkRequests).toEqual(['top/0/0/0/0', 'top/0/0/0/0']);
+    expect(s.settled()).toBe(true);
+    expect(server.requests.filter((r) => r.name === TOP).length).toBe(2);
   });
 
   it('fetches again a chunk named while its reload was in flight', async () => {
-    const server = heldServer(1);
-    const { s, shown, step } = streamerOn(server);
-    await step();
-    await step();
-    await server.releaseAll();
-    server.edit('top/0/0/0/0');
-    s.reload(['top/0/0/0/0']);
+    const { server, s, shown, step } = await loadedStreamer();
+    server.edit('top/1/0/0/0');
+    s.reload(['top/1/0/0/0']);
     await step(); // the reload is asked (version 2)
-    server.edit('top/0/0/0/0'); // a second edit while it is in flight
-    s.reload(['top/0/0/0/0']);
+    server.edit('top/1/0/0/0'); // a second edit while it is in flight
+    s.reload(['top/1/0/0/0']);
     await server.releaseAll();
-    expect(shown.get('top/0/0/0/0')).toBe(2);
+    expect(shown.get('top/1/0/0/0')!.triangles).toBe(2);
     await step();
     await server.releaseAll();
-    expect(shown.get('top/0/0/0/0')).toBe(3);
-    expect(server.chunkRequests.length).toBe(3);
+    expect(shown.get('top/1/0/0/0')!.triangles).toBe(3);
+    expect(server.requests.filter((r) => r.name === 'top/1/0/0/0').length).toBe(3);
   });
 
   it('keeps the old mesh when a reload fails and tries again', async () => {
-    let fail = false;
-    const server = heldServer(1);
-    const fetchFn = (url: string, init?: RequestInit): Promise<Response> =>
-      fail && url.includes('/chunk/')
-        ? Promise.resolve(new Response(JSON.stringify({ error: 'busy' }), { status: 503, headers: { 'Retry-After': '0' } }))
-        : server.fetchFn(url, init);
-    const shown = new Map<string, number>();
     let clock = 0;
-    const s = new ChunkStreamer(new PmcApi('/api/v1', fetchFn), {
-      onLoad: (k, c) => shown.set(k, c.indexCount / 3),
-      onUnload: (k) => shown.delete(k),
-      onError: () => undefined,
-    }, { now: () => clock });
-    s.setPlanet({});
-    for (let n = 0; n < 3; n++) { s.update([0, 0, 0], 100, all); await tick(); }
-    await server.releaseAll();
-    server.edit('top/0/0/0/0');
-    fail = true;
-    s.reload(['top/0/0/0/0']);
-    for (let n = 0; n < 3; n++) { s.update([0, 0, 0], 100, all); await tick(); }
-    expect(shown.get('top/0/0/0/0')).toBe(1);
+    const { server, s, shown, step } = await loadedStreamer({ now: () => clock });
+    server.edit(TOP.replace('top', 'north'));
+    server.fail('north/2/0/0/0', 1);
+    s.reload(['north/2/0/0/0']);
+    await step(3);
+    expect(shown.get('north/2/0/0/0')!.triangles).toBe(1);
     expect(s.stats()).toMatchObject({ stale: 1, failed: 1 });
-    fail = false;
     clock += 1000;
-    for (let n = 0; n < 3; n++) { s.update([0, 0, 0], 100, all); await tick(); }
+    await step(2);
     await server.releaseAll();
-    expect(shown.get('top/0/0/0/0')).toBe(2);
+    expect(shown.get('north/2/0/0/0')!.triangles).toBe(2);
     expect(s.stats().stale).toBe(0);
   });
 
-  it('reloads everything loaded or loading on reloadAll', async () => {
-    const server = heldServer(3);
-    const { s, step } = streamerOn(server);
+  it('reloads everything shown or loading on reloadAll', async () => {
+    const { server, s, step } = await loadedStreamer();
+    s.setSelection(selection([TOP, 'top/1/0/0/0']), VIEW);
     await step();
+    expect(server.held().length).toBe(4);
+    expect(s.reloadAll()).toBe(9 + 4);
     await step();
-    await server.releaseAll();
-    await step();
-    expect(s.reloadAll()).toBe(3);
-    await step();
-    expect(server.held().sort()).toEqual(['top/0/0/0/0', 'top/0/1/0/0', 'top/0/2/0/0']);
+    // the four in flight are fetched again once they answer; the nine shown now
+    expect(server.held().length).toBe(4 + 9);
   });
 
   it('forgets reloads when the planet changes', async () => {
-    const server = heldServer(1);
-    const { s, step } = streamerOn(server);
-    await step();
-    await step();
-    await server.releaseAll();
-    s.reload(['top/0/0/0/0']);
-    s.setPlanet({ preset: 'moon' });
+    const { s } = await loadedStreamer();
+    s.reload(['top/1/0/0/0']);
+    s.setPlanet({ preset: 'moon' }, null);
     expect(s.stats()).toMatchObject({ stale: 0, reloading: 0, reloads: 0, loaded: 0 });
   });
 });

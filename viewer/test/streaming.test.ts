@@ -1,127 +1,335 @@
 import { describe, expect, it } from 'vitest';
-import { ApiError, PmcApi, type ChunkEntry } from '../src/api';
-import { ChunkStreamer, retryDelay } from '../src/chunkStreamer';
-import type { V3 } from '../src/frames';
-import { encodeChunk } from './encodeChunk';
+import { ApiError, PmcApi } from '../src/api';
+import { chunkName, HOLE_PRIORITY } from '../src/chunkSelection';
+import { retryDelay } from '../src/chunkStreamer';
+import { chunkServer, holes, overlaps, selection, streamerOn, VIEW } from './lodFixture';
 
-/** A fake server: chunks along +X, 10 m apart; records requests; can fail some. */
-function fakeServer(opts: { fail?: Map<string, number> } = {}) {
-  const requests: string[] = [];
-  const chunks: ChunkEntry[] = Array.from({ length: 20 }, (_, n) => ({
-    key: `top/0/${n}/0/0`, face: 'top', level: 0, i: n, j: 0, k: 0,
-    center: [10 * n, 0, 0], radius: 2, distance: 0,
-  }));
-  const fetchFn = async (url: string): Promise<Response> => {
-    requests.push(url);
-    const u = new URL(url, 'http://host/');
-    if (u.pathname === '/api/v1/chunks') {
-      const at = ['x', 'y', 'z'].map((k) => Number(u.searchParams.get(k)));
-      const range = Number(u.searchParams.get('range'));
-      const list = chunks
-        .map((c) => ({ ...c, distance: Math.max(0, Math.hypot(c.center[0] - at[0]!, c.center[1] - at[1]!, c.center[2] - at[2]!) - c.radius) }))
-        .filter((c) => c.distance <= range);
-      return new Response(JSON.stringify({ chunks: list, total_in_range: list.length }), { status: 200 });
+const TOP = 'top/2/0/0/0';
+const TOP_CHILDREN = ['top/1/0/0/0', 'top/1/0/1/0', 'top/1/1/0/0', 'top/1/1/1/0'];
+const ROOTS = ['top', 'bottom', 'north', 'south', 'east', 'west'].map((f) => `${f}/2/0/0/0`);
+
+describe('ChunkStreamer: what is fetched', () => {
+  it('fetches the drawn leaves with their seams, most urgent first, a few at a time, until exactly they are shown', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 3 });
+    const sel = selection([TOP, 'top/1/0/0/0'], { 'top/0/1/0/0': 2, 'top/0/1/1/0': 2, 'top/1/0/1/0': 0 }, ['west/2/0/0/0']);
+    s.setSelection(sel, VIEW);
+    await step();
+    expect(s.stats().pending).toBe(3);
+    expect(s.stats()).toMatchObject({ wanted: 11, selected: 12, exact: false, complete: false });
+    // every answer lets the next requests go, never more than three at a time
+    for (let n = 0; n < 10 && !s.settled(); n++) {
+      await server.releaseAll();
+      await step();
+      expect(s.stats().pending).toBeLessThanOrEqual(3);
     }
-    const m = /^\/api\/v1\/chunk\/(.+)$/.exec(u.pathname);
-    if (m) {
-      const key = m[1]!;
-      const left = opts.fail?.get(key) ?? 0;
-      if (left > 0) {
-        opts.fail!.set(key, left - 1);
-        return new Response(JSON.stringify({ error: 'queue full' }), { status: 503, headers: { 'Retry-After': '0' } });
-      }
-      const i = Number(key.split('/')[2]);
-      const bytes = encodeChunk({ i, origin: [10 * i, 0, 0], positions: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], indices: [0, 1, 2] });
-      return new Response(bytes, { status: 200 });
-    }
-    return new Response(JSON.stringify({ error: `no ${u.pathname}` }), { status: 404 });
-  };
-  return { requests, fetchFn };
-}
-
-const tick = (): Promise<void> => new Promise((r) => setTimeout(r, 0));
-const all = (): boolean => true;
-
-describe('ChunkStreamer', () => {
-  it('loads what is in range, 6 at a time, then unloads what the camera left', async () => {
-    const server = fakeServer();
-    const api = new PmcApi('/api/v1', server.fetchFn);
-    const loaded = new Set<string>();
-    let clock = 0;
-    const s = new ChunkStreamer(api, {
-      onLoad: (key) => loaded.add(key),
-      onUnload: (key) => loaded.delete(key),
-      onError: (m) => { throw new Error(m); },
-    }, { now: () => clock });
-    s.setPlanet({ preset: 'earthlike', seed: '7' });
-    const cam: V3 = [0, 0, 0];
-    s.update(cam, 45, all);
-    await tick();
-    expect(server.requests[0]).toBe('/api/v1/chunks?preset=earthlike&seed=7&x=0&y=0&z=0&range=56.25&limit=4096');
-    s.update(cam, 45, all);
-    expect(s.stats().pending).toBe(5); // chunks 0..4 are within 45 m
-    for (let n = 0; n < 10; n++) { await tick(); s.update(cam, 45, all); }
-    expect([...loaded].sort()).toEqual(['top/0/0/0/0', 'top/0/1/0/0', 'top/0/2/0/0', 'top/0/3/0/0', 'top/0/4/0/0']);
-    expect(s.settled(cam, 45)).toBe(true);
-    expect(s.stats().triangles).toBe(5);
-
-    // move 100 m along the row: re-query, load the new ones, drop the old ones
-    const far: V3 = [100, 0, 0];
-    for (let n = 0; n < 20; n++) { s.update(far, 45, all); await tick(); clock += 16; }
-    expect(loaded.has('top/0/10/0/0')).toBe(true);
-    expect(loaded.has('top/0/0/0/0')).toBe(false);
-    expect(s.stats().pending).toBe(0);
-    expect(server.requests.filter((r) => r.includes('/chunks?')).length).toBe(2);
+    expect(s.settled()).toBe(true);
+    const wanted = sel.chunks.filter((c) => c.drawn);
+    expect(server.requests.length).toBe(wanted.length);
+    expect(server.requests.find((r) => r.name === 'top/0/1/0/0')!.seams).toBe(2);
+    expect(server.requests.some((r) => r.name === 'west/2/0/0/0')).toBe(false); // not drawn
+    expect(new Map([...shown].map(([n, v]) => [n, v.seams]))).toEqual(new Map(wanted.map((c) => [chunkName(c.key), c.coarser])));
+    // nothing was shown at first: the first three carry the hole bonus and are the most urgent
+    const first = server.requests.slice(0, 3).map((r) => r.priority);
+    const rest = server.requests.slice(3).map((r) => r.priority);
+    expect(Math.min(...first)).toBeGreaterThanOrEqual(HOLE_PRIORITY);
+    expect(Math.min(...first)).toBeGreaterThanOrEqual(Math.max(...rest));
+    expect(s.stats()).toMatchObject({ shown: 11, pending: 0, missing: 0, exact: true, complete: true, levels: [4, 3, 4] });
   });
 
-  it('never has more than 6 requests in flight', async () => {
-    const server = fakeServer();
-    const s = new ChunkStreamer(new PmcApi('/api/v1', server.fetchFn), {
-      onLoad: () => undefined, onUnload: () => undefined, onError: () => undefined,
-    });
-    s.setPlanet({});
-    s.update([0, 0, 0], 1000, all);
-    await tick();
-    s.update([0, 0, 0], 1000, all);
-    expect(s.stats().pending).toBe(6);
-    s.update([0, 0, 0], 1000, all);
-    expect(s.stats().pending).toBe(6);
+  it('aborts the requests of chunks no longer wanted, and does not ask them again', async () => {
+    const server = chunkServer();
+    const { s, step } = streamerOn(server, { maxConcurrent: 20 });
+    s.setSelection(selection([TOP]), VIEW);
+    await step();
+    expect(server.held().sort()).toEqual([...ROOTS.slice(1), ...TOP_CHILDREN].map((n) => `${n}~0`).sort());
+    // the camera moved: the top face is coarse again and the bottom one finer
+    s.setSelection(selection(['bottom/2/0/0/0']), VIEW);
+    expect(server.aborted.sort()).toEqual([...TOP_CHILDREN, 'bottom/2/0/0/0'].map((n) => `${n}~0`).sort());
+    expect(s.stats().aborted).toBe(5);
+    await step(3);
+    expect(server.held().filter((h) => h.startsWith('top/1/'))).toEqual([]);
+    expect(server.held()).toContain(`${TOP}~0`);
+    await server.releaseAll();
+    await step(3);
+    expect(s.settled()).toBe(true);
+    expect(server.requests.filter((r) => r.name.startsWith('top/1/')).length).toBe(4);
   });
 
-  it('retries a busy chunk later and reports nothing for a transient failure', async () => {
-    const server = fakeServer({ fail: new Map([['top/0/0/0/0', 1]]) });
-    const errors: string[] = [];
+  it('wants the ground under the camera even out of the view', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server);
+    // nothing drawn (the camera looks at the sky): the chunk under it is fetched all the same
+    s.setSelection(selection([], {}, ROOTS), VIEW);
+    await step();
+    expect(server.held()).toEqual(['east/2/0/0/0~0']);
+    await server.releaseAll();
+    await step();
+    expect([...shown.keys()]).toEqual(['east/2/0/0/0']);
+    expect(s.settled()).toBe(true);
+  });
+
+  it('fetches the chunks between a chunk shown and wanted chunks two levels below it, and shows them meanwhile', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 20 });
+    s.setSelection(selection(), VIEW);
+    await step();
+    await server.releaseAll();
+    await step();
+    // the top root is shown; now four level-0 chunks under top/1/0/0/0 are wanted
+    s.setSelection(selection([TOP, 'top/1/0/0/0']), VIEW);
+    await step();
+    expect(s.stats()).toMatchObject({ wanted: 12, bridges: 1 });
+    expect(server.held()).toContain('top/1/0/0/0~0');
+    expect(server.requests.find((r) => r.name === 'top/1/0/0/0')!.priority).toBeGreaterThan(
+      Math.max(...server.requests.filter((r) => r.name.startsWith('top/0/')).map((r) => r.priority)),
+    );
+    // the bridge and its siblings come first: the top face refines one level
+    await server.release(...TOP_CHILDREN);
+    await step();
+    expect(shown.has(TOP)).toBe(false);
+    expect([...shown.keys()].filter((n) => n.startsWith('top/')).sort()).toEqual(TOP_CHILDREN);
+    expect(s.settled()).toBe(false);
+    await server.releaseAll();
+    await step();
+    expect(shown.has('top/1/0/0/0')).toBe(false);
+    expect(shown.has('top/0/0/0/0')).toBe(true);
+    expect(s.settled()).toBe(true);
+    expect(s.stats().bridges).toBe(0);
+  });
+
+  it('drops a bridge that is no longer needed', async () => {
+    const server = chunkServer();
+    const { s, step } = streamerOn(server, { maxConcurrent: 20 });
+    s.setSelection(selection(), VIEW);
+    await step();
+    await server.releaseAll();
+    await step();
+    s.setSelection(selection([TOP, 'top/1/0/0/0']), VIEW);
+    await step();
+    // everything wanted arrives before the bridge
+    await server.release(...TOP_CHILDREN.slice(1), 'top/0/0/0/0', 'top/0/0/1/0', 'top/0/1/0/0', 'top/0/1/1/0');
+    await step();
+    expect(server.aborted).toEqual(['top/1/0/0/0~0']);
+    expect(s.settled()).toBe(true);
+  });
+
+  it('retries a busy chunk after its Retry-After without reporting it', async () => {
+    const server = chunkServer();
     let clock = 0;
-    const loaded = new Set<string>();
-    const s = new ChunkStreamer(new PmcApi('/api/v1', server.fetchFn), {
-      onLoad: (k) => loaded.add(k), onUnload: (k) => loaded.delete(k), onError: (m) => errors.push(m),
-    }, { now: () => clock });
-    s.setPlanet({});
-    for (let n = 0; n < 10; n++) { s.update([0, 0, 0], 5, all); await tick(); }
-    expect(loaded.size).toBe(0);
+    const { s, shown, errors, step } = streamerOn(server, { now: () => clock });
+    server.fail(TOP, 1);
+    s.setSelection(selection(), VIEW);
+    await step(2);
+    await server.releaseAll();
+    await step(2);
+    expect(shown.has(TOP)).toBe(false);
     expect(s.stats().failed).toBe(1);
-    expect(s.settled([0, 0, 0], 5)).toBe(false);
+    expect(s.settled()).toBe(false);
     clock += 1000; // past Retry-After
-    for (let n = 0; n < 10; n++) { s.update([0, 0, 0], 5, all); await tick(); }
-    expect([...loaded]).toEqual(['top/0/0/0/0']);
+    await step(2);
+    await server.releaseAll();
+    await step();
+    expect(shown.has(TOP)).toBe(true);
+    expect(s.settled()).toBe(true);
     expect(errors).toEqual([]);
   });
 
+  it('counts an empty chunk as loaded', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server);
+    for (const r of ROOTS.slice(1)) server.empty.add(r);
+    s.setSelection(selection(), VIEW);
+    await step(2);
+    await server.releaseAll();
+    await step(2);
+    expect(s.settled()).toBe(true);
+    expect(shown.size).toBe(6);
+    expect(s.stats()).toMatchObject({ shown: 6, triangles: 1, exact: true });
+  });
+
   it('drops everything when the planet changes', async () => {
-    const server = fakeServer();
-    const unloaded: string[] = [];
-    const s = new ChunkStreamer(new PmcApi('/api/v1', server.fetchFn), {
-      onLoad: () => undefined, onUnload: (k) => unloaded.push(k), onError: () => undefined,
-    });
-    s.setPlanet({ preset: 'moon' });
-    for (let n = 0; n < 10; n++) { s.update([0, 0, 0], 15, all); await tick(); }
-    expect(s.stats().loaded).toBe(2);
-    s.setPlanet({ preset: 'mars', seed: '3' });
-    expect(unloaded.sort()).toEqual(['top/0/0/0/0', 'top/0/1/0/0']);
-    expect(s.stats()).toMatchObject({ loaded: 0, pending: 0, requested: 0 });
-    s.update([0, 0, 0], 15, all);
-    await tick();
-    expect(server.requests.at(-1)).toContain('preset=mars&seed=3');
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 3 });
+    s.setSelection(selection(), VIEW);
+    await step();
+    await server.release(...server.held().map((h) => h.split('~')[0]!));
+    await step();
+    expect(shown.size).toBe(3);
+    s.setPlanet({ preset: 'moon' }, null);
+    expect(shown.size).toBe(0);
+    expect(server.aborted.length).toBe(3);
+    expect(s.stats()).toMatchObject({ loaded: 0, pending: 0, requested: 0, shown: 0 });
+  });
+});
+
+describe('ChunkStreamer: no hole, no flicker', () => {
+  it('keeps a chunk being refined until all its wanted children are there', async () => {
+    const server = chunkServer();
+    const { s, shown, log, step } = streamerOn(server, { maxConcurrent: 8 });
+    s.setSelection(selection(), VIEW);
+    await step(2);
+    await server.releaseAll();
+    await step();
+    expect([...shown.keys()].sort()).toEqual([...ROOTS].sort());
+    const fine = selection([TOP], {}, ['top/1/1/0/0']); // one child out of the view
+    s.setSelection(fine, VIEW);
+    await step();
+    expect(server.held().sort()).toEqual(['top/1/0/0/0~0', 'top/1/0/1/0~0', 'top/1/1/1/0~0']);
+    await server.release('top/1/0/0/0', 'top/1/0/1/0');
+    await step();
+    expect(shown.has(TOP)).toBe(true);
+    expect(shown.has('top/1/0/0/0')).toBe(false);
+    expect(holes(fine, shown.keys())).toEqual([]);
+    await server.release('top/1/1/1/0');
+    await step();
+    // the child out of the view is not needed
+    expect(shown.has(TOP)).toBe(false);
+    expect([...shown.keys()].filter((n) => n.startsWith('top/')).sort()).toEqual(['top/1/0/0/0', 'top/1/0/1/0', 'top/1/1/1/0']);
+    expect(s.settled()).toBe(true);
+    // the parent went in the same step as its children came
+    const swap = log.slice(log.indexOf('hide top/2/0/0/0'));
+    expect(swap.slice(0, 4).sort()).toEqual(['hide top/2/0/0/0', 'show top/1/0/0/0~0', 'show top/1/0/1/0~0', 'show top/1/1/1/0~0']);
+  });
+
+  it('keeps the children of a chunk being coarsened until the chunk is there', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 20 });
+    s.setSelection(selection([TOP, 'top/1/0/0/0']), VIEW);
+    await step();
+    await server.releaseAll();
+    await step();
+    expect(s.settled()).toBe(true);
+    expect(shown.has(TOP)).toBe(false);
+    const coarse = selection();
+    s.setSelection(coarse, VIEW);
+    await step();
+    expect(server.held()).toEqual([`${TOP}~0`]);
+    // meanwhile the finer chunks stay, without overlap or hole
+    for (const c of [...TOP_CHILDREN.slice(1), 'top/0/0/0/0', 'top/0/1/1/0']) expect(shown.has(c)).toBe(true);
+    expect(overlaps(shown.keys())).toEqual([]);
+    expect(holes(coarse, shown.keys())).toEqual([]);
+    expect(s.settled()).toBe(false);
+    await server.release(TOP);
+    await step();
+    expect([...shown.keys()].sort()).toEqual([...ROOTS].sort());
+    expect(s.settled()).toBe(true);
+    // the finer chunks stay in the cache for a while
+    expect(s.stats().loaded).toBe(6 + 3 + 4);
+  });
+
+  it('keeps showing the old seams variant until the new one arrives', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 20 });
+    s.setSelection(selection([TOP]), VIEW);
+    await step();
+    await server.releaseAll();
+    await step();
+    expect(shown.get('top/1/0/0/0')!.seams).toBe(0);
+    // a neighbour became coarser: the same chunk, now with two seams
+    s.setSelection(selection([TOP], { 'top/1/0/0/0': 5 }), VIEW);
+    await step();
+    expect(server.held()).toEqual(['top/1/0/0/0~5']);
+    expect(shown.get('top/1/0/0/0')!.seams).toBe(0);
+    expect(s.settled()).toBe(false);
+    await server.releaseAll();
+    await step();
+    expect(shown.get('top/1/0/0/0')!.seams).toBe(5);
+    expect(s.settled()).toBe(true);
+    expect(s.stats().loaded).toBe(5 + 4 + 1); // both variants kept
+    // and back: the old variant is still loaded, shown at once, nothing fetched
+    const before = server.requests.length;
+    s.setSelection(selection([TOP]), VIEW);
+    await step();
+    expect(shown.get('top/1/0/0/0')!.seams).toBe(0);
+    expect(server.requests.length).toBe(before);
+    expect(s.settled()).toBe(true);
+  });
+
+  it('shows no two overlapping chunks and leaves no hole through a series of selections', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 2 });
+    const sequence = [
+      selection(),
+      selection([TOP, 'top/1/0/0/0']),
+      selection([TOP, 'top/1/1/1/0'], { 'top/0/2/2/0': 3 }),
+      selection(['north/2/0/0/0']),
+      selection([TOP]),
+    ];
+    let first = true;
+    for (const sel of sequence) {
+      s.setSelection(sel, VIEW);
+      for (let n = 0; n < 40 && !s.settled(); n++) {
+        // answer one request at a time, oldest first
+        const next = server.held()[0];
+        if (next) await server.release(next.split('~')[0]!);
+        await step();
+        expect(overlaps(shown.keys())).toEqual([]);
+        if (!first) expect(holes(sel, shown.keys())).toEqual([]);
+      }
+      expect(s.settled()).toBe(true);
+      first = false;
+    }
+  });
+});
+
+describe('ChunkStreamer: memory', () => {
+  it('drops the least recently wanted chunks that are neither shown nor wanted, over the cap', async () => {
+    const server = chunkServer();
+    const { s, shown, step } = streamerOn(server, { maxConcurrent: 20, maxLoaded: 13 });
+    const load = async (splits: string[]): Promise<void> => {
+      s.setSelection(selection(splits), VIEW);
+      await step();
+      await server.releaseAll();
+      await step();
+      expect(s.settled()).toBe(true);
+    };
+    await load([]); // 6 roots
+    await load([TOP]); // + 4: the top root stays in the cache, not shown
+    expect(s.stats()).toMatchObject({ loaded: 10, evicted: 0 });
+    // + 4 bottom children: 14 > 13. The top root is wanted again (and shown from the cache), the
+    // bottom root was shown until its children came: the top children, wanted by the previous
+    // selection only, are the least recently wanted; one of them goes
+    await load(['bottom/2/0/0/0']);
+    expect(s.stats()).toMatchObject({ loaded: 13, evicted: 1 });
+    const before = server.requests.length;
+    await load([TOP]);
+    // three top children came back from the cache, the evicted one is fetched again
+    expect(server.requests.slice(before).map((r) => r.name)).toEqual(['top/1/0/0/0']);
+    // over the cap again: a bottom child goes (wanted two selections ago), nothing shown
+    expect(s.stats()).toMatchObject({ loaded: 13, evicted: 2 });
+    expect([...shown.keys()].filter((n) => n.startsWith('bottom/1/'))).toEqual([]);
+    const again = server.requests.length;
+    await load(['bottom/2/0/0/0']);
+    expect(server.requests.slice(again).map((r) => r.name)).toEqual(['bottom/1/0/0/0']);
+  });
+
+  it('keeps everything shown or wanted even past the cap', async () => {
+    const server = chunkServer();
+    const { s, step } = streamerOn(server, { maxConcurrent: 20, maxLoaded: 2, maxBytes: 100 });
+    s.setSelection(selection([TOP]), VIEW);
+    await step();
+    await server.releaseAll();
+    await step();
+    expect(s.settled()).toBe(true);
+    expect(s.stats()).toMatchObject({ loaded: 9, shown: 9, evicted: 0 });
+  });
+});
+
+describe('retryDelay and the chunk URL', () => {
+  it('backs off', () => {
+    expect(retryDelay(new ApiError('busy', 503, 'u', 2), 1)).toBe(2000);
+    expect(retryDelay(new Error('x'), 1)).toBe(500);
+    expect(retryDelay(new Error('x'), 3)).toBe(2000);
+    expect(retryDelay(new Error('x'), 30)).toBe(30_000);
+  });
+
+  it('asks for a chunk with its seams and priority', () => {
+    const api = new PmcApi('api/v1');
+    expect(api.chunkUrl({ preset: 'earthlike', seed: '7' }, 'top/0/3/4/1', { seams: 5, priority: 12.5 })).toBe(
+      'api/v1/chunk/top/0/3/4/1?preset=earthlike&seed=7&seams=5&priority=12.5',
+    );
+    expect(api.chunkUrl({}, 'top/0/3/4/1')).toBe('api/v1/chunk/top/0/3/4/1');
   });
 });
 
@@ -152,11 +360,5 @@ describe('PmcApi', () => {
     const api = new PmcApi('/api/v1', async () => new Response(JSON.stringify({ format: 'x' }), { status: 200 }));
     await expect(api.planet()).rejects.toThrow(/unexpected \/planet response/);
   });
-
-  it('backs off', () => {
-    expect(retryDelay(new ApiError('busy', 503, 'u', 2), 1)).toBe(2000);
-    expect(retryDelay(new Error('x'), 1)).toBe(500);
-    expect(retryDelay(new Error('x'), 3)).toBe(2000);
-    expect(retryDelay(new Error('x'), 30)).toBe(30_000);
-  });
 });
+
