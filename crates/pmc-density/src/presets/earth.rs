@@ -474,10 +474,20 @@ impl EarthModel {
     }
 
     /// Refines `col` until its height is known within `tol` metres (or the ladder ends).
+    #[cfg(test)]
     pub(crate) fn refine_to(&self, col: &mut EarthColumn, dir: DVec3, tol: f64) {
         while col.done < self.entries.len() && col.rem[col.done] > tol {
             self.advance(col, dir);
         }
+    }
+
+    /// Whether `h - r > depth` for the column's full height `h` (every entry), refining only
+    /// until the sound bound on the remaining octaves settles the comparison.
+    pub(crate) fn deeper_than(&self, col: &mut EarthColumn, dir: DVec3, r: f64, depth: f64) -> bool {
+        while col.done < self.entries.len() && (col.h[col.done] - r - depth).abs() <= col.rem[col.done] {
+            self.advance(col, dir);
+        }
+        col.height() - r > depth
     }
 
     /// The full height of the column (every entry evaluated).
@@ -622,6 +632,10 @@ impl Density for EarthDensity {
         // The point call sees `|dir * r|`; the batch takes the same radius so both follow the
         // same path (they differ only by the rounding of the direction).
         let mut rs = vec![0.0; radii.len()];
+        // Layer radii come in increasing order from every chunk grid; `|dir * r|` keeps that
+        // order (each rounded operation is monotone), so the samples still refining form one
+        // run of them.
+        let sorted = radii.windows(2).all(|w| w[0] <= w[1]) && radii.first().is_none_or(|r| *r >= 0.0);
         for (d, dir) in dirs.iter().enumerate() {
             let (mut r_min, mut r_max) = (f64::INFINITY, f64::NEG_INFINITY);
             for (x, r) in rs.iter_mut().zip(radii) {
@@ -630,11 +644,29 @@ impl Density for EarthDensity {
                 r_max = r_max.max(*x);
             }
             let mut col = m.column(*dir);
-            // Refine while some radius between the column's extremes may still need it. Refining
-            // further than a sample needs never changes its value (its stopping entry depends on
-            // the sample alone), so this cheap test is enough.
-            while col.done < m.entries.len() && col.keep_lo[col.done] < r_max && r_min < col.keep_hi[col.done] {
-                m.advance(&mut col, *dir);
+            // Refine while some sample may still need it. Refining further than a sample needs
+            // never changes its value (its stopping entry depends on the sample alone), so the
+            // column stops as soon as no sample lies inside its (nested, shrinking) interval:
+            // a chunk whose layers are far apart stops long before the ladder's end.
+            if sorted {
+                let (mut a, mut b) = (0, rs.len());
+                while col.done < m.entries.len() {
+                    let k = col.done;
+                    while a < b && rs[a] <= col.keep_lo[k] {
+                        a += 1;
+                    }
+                    while a < b && rs[b - 1] >= col.keep_hi[k] {
+                        b -= 1;
+                    }
+                    if a == b {
+                        break;
+                    }
+                    m.advance(&mut col, *dir);
+                }
+            } else {
+                while col.done < m.entries.len() && col.keep_lo[col.done] < r_max && r_min < col.keep_hi[col.done] {
+                    m.advance(&mut col, *dir);
+                }
             }
             for (k, r) in rs.iter().enumerate() {
                 out[k * n + d] = m.value(&col, *dir, *r) as f32;
@@ -698,10 +730,11 @@ impl EarthShader {
         let r = p.length();
         let dir = if r > 0.0 { p / r } else { DVec3::Y };
         let mut col = m.column(dir);
-        // A quarter voxel is plenty for colours: the finest octaves are left out.
-        m.refine_to(&mut col, dir, 0.25 * l_d);
-        let h = col.height();
-        if h - r > (1.5 * l_d).max(col.a_rock + col.a_cliff + l_d) {
+        // Cave rock: well under the height field. Rock bumps and cliffs move the surface by at
+        // most `a_rock + a_cliff`, less than the threshold, so only carved caves get there:
+        // columns without caves need no height at all.
+        let cave_depth = (1.5 * l_d).max(col.a_rock + col.a_cliff + l_d);
+        if col.cave_gate > 0.0 && m.deeper_than(&mut col, dir, r, cave_depth) {
             return CAVE;
         }
         // Heights above the sea: in layout metres for the shore, in true-scale metres for the
@@ -1062,6 +1095,35 @@ mod tests {
     }
 
     #[test]
+    fn a_batch_stops_refining_early_with_the_same_bits_as_points() {
+        // Columns stop refining once no sample of the batch needs more: a batch of layers far
+        // apart stops early, and every sample keeps the point call's bits, in increasing or any
+        // other order of radii.
+        let (_, m, d) = earth(7);
+        for (n, dir) in sphere_dirs(60).into_iter().enumerate() {
+            let (_, h) = full(&m, dir);
+            for step in [1.0, 8.0, 128.0, 4096.0] {
+                let r0 = (h / step).floor() * step - 17.0 * step + 0.37 * (n as f64);
+                let mut radii: Vec<f64> = (0..35).map(|i| r0 + step * f64::from(i)).collect();
+                for pass in 0..2 {
+                    let mut out = vec![0.0f32; radii.len()];
+                    d.sample_shell(&[dir], &radii, &mut out);
+                    for (r, v) in radii.iter().zip(&out) {
+                        let point = d.density(dir * *r) as f32;
+                        assert_eq!(
+                            v.to_bits(),
+                            point.to_bits(),
+                            "step {step}, pass {pass}, r - h = {}",
+                            r - h
+                        );
+                    }
+                    radii.reverse();
+                }
+            }
+        }
+    }
+
+    #[test]
     fn surface_within_bounds_at_true_scale() {
         // Sparser than the shared check (the shell is 32 768 voxels deep).
         let (layout, _, d) = earth(3);
@@ -1136,6 +1198,38 @@ mod tests {
         1141219514, 3311686120, 3259692377, 1127700414, 1139982708, 3311886824, 3368242866, 3368234533, 3368230208,
         3368363998,
     ];
+
+    #[test]
+    fn cave_rock_is_decided_by_the_full_height() {
+        // The shader refines a column only until the comparison with the cave depth is settled:
+        // the answer is that of the full ladder, and columns without caves are never cave rock.
+        let (_, m, _) = earth(7);
+        let shader = EarthShader::new(m.clone(), 7);
+        let (mut caves, mut plain) = (0, 0);
+        for dir in sphere_dirs(3000) {
+            let (c, h) = full(&m, dir);
+            if h < m.sea + 20.0 {
+                continue;
+            }
+            let depth = (1.5 * m.s.l_d).max(c.a_rock + c.a_cliff + m.s.l_d);
+            for dz in [-60.0, -20.0, -8.0, -3.0, -depth - 0.01, -depth + 0.01, -1.0, 0.0, 2.0] {
+                let r = h + dz;
+                let cave = shader.material(dir * r, dir) == CAVE;
+                assert_eq!(
+                    cave,
+                    c.cave_gate > 0.0 && h - r > depth,
+                    "dz {dz}, gate {}",
+                    c.cave_gate
+                );
+                if cave {
+                    caves += 1;
+                } else {
+                    plain += 1;
+                }
+            }
+        }
+        assert!(caves > 100 && plain > 100, "{caves} cave, {plain} other");
+    }
 
     #[test]
     fn shader_tells_the_seabed_the_beach_and_the_peaks_apart() {
