@@ -5,7 +5,13 @@
 // the stats panel's level histogram must follow the height; a still camera must give the same
 // picture twice (no jitter, also at 6.4e6 m from the planet's centre).
 
-/** Pixels of the back-face flag colour (#ff00ff), within `tolerance` summed over the channels. */
+/**
+ * Pixels of the back-face flag colour (#ff00ff), within `tolerance` summed over the channels: a
+ * gap a pixel wide or more. Sub-pixel slivers along chunk seams far away, where the flag colour
+ * only tints an antialiased pixel, are not counted: they come from rasterising the two sides of a
+ * seam from float32 positions relative to different chunk origins, not from the meshes, whose
+ * closedness the Rust tests prove by vertex key.
+ */
 export function flaggedPixels(img, tolerance = 60) {
   let n = 0;
   for (let i = 0; i < img.data.length; i += 4) {
@@ -14,14 +20,15 @@ export function flaggedPixels(img, tolerance = 60) {
   return n;
 }
 
-/** Pixels of colour `c` (within `tolerance` summed over the channels) in rows `y0..y1` of `img`. */
-export function pixelsOf(img, c, y0 = 0, y1 = img.height, tolerance = 6) {
+/**
+ * Pixels of background colour `bg` (within 6, summed over the channels) in `img` that are not of
+ * that colour in `ref`: places where nothing is drawn that are drawn in the converged picture.
+ */
+export function newBackground(img, ref, bg) {
+  const is = (d, i) => Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) <= 6;
   let n = 0;
-  for (let y = y0; y < y1; y++) {
-    for (let x = 0; x < img.width; x++) {
-      const i = 4 * (y * img.width + x);
-      if (Math.abs(img.data[i] - c[0]) + Math.abs(img.data[i + 1] - c[1]) + Math.abs(img.data[i + 2] - c[2]) <= tolerance) n++;
-    }
+  for (let i = 0; i < img.data.length; i += 4) {
+    if (is(img.data, i) && !is(ref.data, i)) n++;
   }
   return n;
 }
@@ -115,7 +122,7 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
       const s = await hook(() => window.__pmc.stats());
       if (s.ready) break;
       const img = await shot(`${label}-${stop.name}-during-${n}`);
-      during.push({ img, pending: s.pending, levels: s.lod.levelsText });
+      during.push({ img, pending: s.pending, levels: s.lod.levelsText, background: s.background });
     }
     let s = await ready(`${label} ${stop.name}`);
     if (!stop.orbit) {
@@ -131,9 +138,6 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
     const panel = await t.page.textContent('#s-levels');
     const img = await shot(`${label}-${stop.name}`);
     const flagged = flaggedPixels(img);
-    const sky = img.data.slice(0, 3);
-    const rows = [Math.floor(img.height * 0.7), img.height];
-    const skyBelow = pixelsOf(img, sky, rows[0], rows[1]);
     const range = levelRange(s.lod.levels);
     log(
       `  ${stop.name}: camera ${s.alt.toFixed(1)} m above the datum, ${s.aboveGround?.toFixed(1)} m above the ground; ${s.shown} chunks shown, ${s.triangles} triangles, levels ${s.lod.levelsText} ` +
@@ -144,12 +148,14 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
     check(panel === s.lod.levelsText, `${label} ${stop.name}: the panel says "${panel}", the stats "${s.lod.levelsText}"`);
     for (const [n, d] of during.entries()) {
       const f = flaggedPixels(d.img);
-      const below = pixelsOf(d.img, sky, rows[0], rows[1]);
-      log(`    while loading (${d.pending} pending, ${d.levels}): ${f} flagged, ${below} background pixels in the lowest rows (converged: ${skyBelow})`);
+      // a hole shows the background where the converged picture has terrain (the background
+      // colour of that moment: it follows the altitude)
+      const holes = newBackground(d.img, img, d.background);
+      log(`    while loading (${d.pending} pending, ${d.levels}): ${f} flagged, ${holes} background pixels where terrain is drawn once converged`);
       check(f === 0, `${label} on the way to ${stop.name}: ${f} flagged pixels (a crack or a hole): see ${label}-${stop.name}-during-${n}.png`);
       check(
-        below <= skyBelow + 0.002 * img.width * img.height,
-        `${label} on the way to ${stop.name}: ${below} background pixels in the lowest rows against ${skyBelow} converged (a hole): see ${label}-${stop.name}-during-${n}.png`,
+        holes <= 0.001 * img.width * img.height,
+        `${label} on the way to ${stop.name}: ${holes} background pixels where terrain is drawn once converged (a hole): see ${label}-${stop.name}-during-${n}.png`,
       );
     }
     if (pictures) {

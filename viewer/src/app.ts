@@ -82,6 +82,8 @@ export interface PmcStats {
   error: string | null;
   /** The chunks shown (`face/level/i/j/k`). */
   loadedKeys: string[];
+  /** The background colour drawn now (8-bit sRGB): what shows where nothing is drawn. */
+  background: [number, number, number];
   lod: PmcLodStats;
   /** Loaded chunks waiting for a refetch after an edit, refetches under way, refetches made. */
   stale: number;
@@ -1007,6 +1009,7 @@ export class App {
       ready: this.settledFrames >= 2,
       error: this.error,
       loadedKeys: this.streamer.shownNames(),
+      background: this.scene.backgroundRgb(),
       lod: {
         ...lod,
         levelsText: formatLevels(st.levels),

@@ -157,6 +157,12 @@ export class PlanetScene {
     this.background.copy(SPACE_BACKGROUND).lerp(SKY_BACKGROUND, t);
   }
 
+  /** The background colour drawn now, as 8-bit sRGB (what a screenshot shows where nothing is drawn). */
+  backgroundRgb(): [number, number, number] {
+    const c = this.background.clone().convertLinearToSRGB();
+    return [Math.round(c.r * 255), Math.round(c.g * 255), Math.round(c.b * 255)];
+  }
+
   /** Sets the planet's shading parameters and rebuilds the sea (chunks are cleared separately). */
   setPlanet(params: PlanetParams): void {
     this.params = params;

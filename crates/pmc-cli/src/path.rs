@@ -1,7 +1,7 @@
 //! `pmc path`: the walking path between two places on a planet (or a world's edited planet), over
 //! its navigation grid, as JSON or GeoJSON (docs/specs/path-v1.md).
 //!
-//! Planets of up to [`EAGER_COLUMNS`] columns get the whole-planet grid (components known, every
+//! Planets of up to [`pmc_nav::EAGER_COLUMNS`] columns get the whole-planet grid (components known, every
 //! path a shortest one); larger ones, the Earth at true scale among them, get the lazy grid, built
 //! tile by tile around the search within its bounds (`--max-expanded`, `--max-tiles`, `--weight`).
 
@@ -11,8 +11,8 @@ use crate::planet_args::PlanetArgs;
 use clap::{Args, ValueEnum};
 use pmc_geometry::LatLon;
 use pmc_nav::{
-    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, Agent, Columns, End, LazyGrid, LazyOptions,
-    NavGrid, PathAnswer, SearchOptions,
+    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, wants_lazy_grid, Agent, End, LazyGrid,
+    LazyOptions, NavGrid, PathAnswer, SearchOptions,
 };
 use std::io::Write;
 use std::path::PathBuf;
@@ -20,10 +20,6 @@ use std::time::Instant;
 
 /// Columns searched around each end for walkable ground.
 pub const SNAP_RINGS: usize = 8;
-
-/// Layouts with more column slots than this (`6 (N + 1)^2`; `n_c n_t` above about 800) get the
-/// lazy grid.
-pub const EAGER_COLUMNS: usize = 4_000_000;
 
 /// Output formats of `pmc path`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -149,7 +145,7 @@ pub fn run(args: &PathArgs) -> Result<(), CliError> {
     let datum = planet.datum_radius();
     let (a, b) = (end(from, datum), end(to, datum));
     let start = Instant::now();
-    let lazy = args.lazy || Columns::new(planet.layout()).index_count() > EAGER_COLUMNS;
+    let lazy = args.lazy || wants_lazy_grid(planet.layout());
     let doc = if lazy {
         let mut grid = LazyGrid::new(planet.density().clone(), planet.layout(), agent, LazyOptions::default())
             .map_err(|e| CliError::Edit(e.to_string()))?;

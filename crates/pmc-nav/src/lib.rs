@@ -46,3 +46,13 @@ pub use report::{
     PATH_VERSION,
 };
 pub use search::{find_path, NoPath, Path, SearchOptions, SearchStats};
+
+/// Layouts with more column slots than this (`6 (N + 1)^2`; `n_c n_t` above about 800) are
+/// navigated with the [`LazyGrid`]: a whole-planet [`NavGrid`] of them would take too long to
+/// build for a query (and beyond [`MAX_COLUMNS`], too much memory).
+pub const EAGER_COLUMNS: usize = 4_000_000;
+
+/// Whether paths on `layout` should be searched on the [`LazyGrid`] (see [`EAGER_COLUMNS`]).
+pub fn wants_lazy_grid(layout: &pmc_geometry::Layout) -> bool {
+    Columns::new(layout).index_count() > EAGER_COLUMNS
+}

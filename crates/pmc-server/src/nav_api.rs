@@ -10,7 +10,10 @@ use axum::response::{IntoResponse, Response};
 use axum::Json;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::LatLon;
-use pmc_nav::{path_geojson, path_json, query, Agent, End, NodeId};
+use pmc_nav::{
+    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, wants_lazy_grid, Agent, End, LazyGrid,
+    LazyOptions, NodeId, SearchOptions,
+};
 use serde_json::{json, Value};
 
 /// Columns searched around each end of a path for walkable ground.
@@ -90,8 +93,37 @@ pub async fn path(State(state): State<AppState>, RawQuery(q): RawQuery) -> Resul
         }
     };
     // Checked before any grid is built.
-    let datum_probe = state.planet(id).await.map_err(ApiError::internal)?.0.datum_radius();
+    let (current, revision) = state.planet(id).await.map_err(ApiError::internal)?;
+    let datum_probe = current.datum_radius();
     let (from, to) = (end(&params, "from", datum_probe)?, end(&params, "to", datum_probe)?);
+    if wants_lazy_grid(current.layout()) {
+        // A planet too large for a whole-planet grid (the Earth at true scale): a lazy grid of
+        // the current (edited) planet, built tile by tile around this search within the default
+        // bounds, then dropped.
+        agent.validate().map_err(|e| ApiError::bad_request(e.to_string()))?;
+        let doc = tokio::task::spawn_blocking(move || {
+            let datum = current.datum_radius();
+            let mut grid = LazyGrid::new(
+                current.density().clone(),
+                current.layout(),
+                agent,
+                LazyOptions::default(),
+            )
+            .map_err(|e| ApiError::bad_request(e.to_string()))?;
+            let search = SearchOptions::default();
+            let found = grid.query(from, to, SNAP_RINGS, &search);
+            let mut doc = if geojson {
+                lazy_path_geojson(&grid, &found, &search, from, to, datum)
+            } else {
+                lazy_path_json(&grid, &found, &search, from, to, datum)
+            };
+            doc["revision"] = json!(revision);
+            Ok::<Value, ApiError>(doc)
+        })
+        .await
+        .map_err(|e| ApiError::internal(format!("the path search failed: {e}")))??;
+        return Ok(no_store(doc));
+    }
     let (grid, planet, revision) = state.nav_grid(id, agent).await?;
     let datum = planet.datum_radius();
     let doc = tokio::task::spawn_blocking(move || {

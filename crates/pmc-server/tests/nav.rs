@@ -200,15 +200,44 @@ async fn a_worlds_grid_follows_its_edits() {
 }
 
 #[tokio::test]
-async fn a_planet_too_large_for_a_grid_gets_a_400_that_says_so() {
+async fn a_planet_too_large_for_a_grid_gets_lazy_paths_and_a_400_for_the_grid() {
+    let layout = pmc_geometry::Layout::new(128, 32, 1000.0, 1.0, 1).unwrap();
+    assert!(pmc_nav::wants_lazy_grid(&layout));
     let config = ServerConfig {
-        layout: pmc_geometry::Layout::new(128, 32, 1000.0, 1.0, 1).unwrap(),
+        layout,
         ..small_config()
     };
     let a = router(AppState::new(config).unwrap());
-    for uri in ["/api/v1/path?from=1,1&to=2,2", "/api/v1/navgrid?x=0&y=1100&z=0&range=5"] {
-        let r = get(&a, uri).await;
-        assert_eq!(r.status, StatusCode::BAD_REQUEST, "{uri}");
-        assert!(r.json()["error"].as_str().unwrap().contains("columns"), "{uri}");
-    }
+    // The grid describes components, which a lazy grid has none of.
+    let r = get(&a, "/api/v1/navgrid?x=0&y=1100&z=0&range=5").await;
+    assert_eq!(r.status, StatusCode::BAD_REQUEST);
+    assert!(r.json()["error"].as_str().unwrap().contains("columns"));
+    // A path: the lazy grid's document, the same path as `pmc path` finds on the same planet.
+    let v = get(&a, "/api/v1/path?from=1,1&to=1.2,1.3").await.json();
+    assert_eq!(v["found"], true, "{v}");
+    assert_eq!(v["revision"], 0);
+    assert!(v["search"]["expanded"].as_u64().unwrap() > 0, "{v}");
+    let planet = Planet::new(small_config().preset, small_config().seed, layout);
+    let mut grid = pmc_nav::LazyGrid::new(
+        planet.density().clone(),
+        planet.layout(),
+        Agent::default(),
+        pmc_nav::LazyOptions::default(),
+    )
+    .unwrap();
+    let search = pmc_nav::SearchOptions::default();
+    let found = grid.query(end(1.0, 1.0), end(1.2, 1.3), 8, &search);
+    let want = pmc_nav::lazy_path_json(
+        &grid,
+        &found,
+        &search,
+        end(1.0, 1.0),
+        end(1.2, 1.3),
+        planet.datum_radius(),
+    );
+    assert_eq!(v["length"], want["length"]);
+    assert_eq!(v["waypoints"], want["waypoints"]);
+    // Bad ends are still refused before any search.
+    let r = get(&a, "/api/v1/path?from=91,1&to=1.2,1.3").await;
+    assert_eq!(r.status, StatusCode::BAD_REQUEST);
 }
