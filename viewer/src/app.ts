@@ -724,6 +724,8 @@ export class App {
       },
       forward,
       up,
+      near: this.camera.near,
+      far: this.camera.far,
     };
   }
 

@@ -110,11 +110,17 @@ export interface ViewState {
   /** The camera's forward and up directions (planet frame, unit). */
   forward: V3;
   up: V3;
+  /** The clip distances the frustum was built with (metres). */
+  near: number;
+  far: number;
 }
 
 /**
  * Whether two views select the same chunks for all practical purposes: the eye within `epsilon`
- * metres, the directions within 1e-9 (cosine), the same viewport, field of view and parameters.
+ * metres, the directions within 1e-9 (cosine), the clip distances within a millionth, the same
+ * viewport, field of view and parameters. The clip distances matter: the near plane follows the
+ * height above the ground, measured a few frames after a teleport, and a selection made with the
+ * old one leaves out every chunk closer than it.
  */
 export function sameView(a: ViewState, b: ViewState, epsilon = 1e-3): boolean {
   const d = Math.hypot(a.view.eye[0] - b.view.eye[0], a.view.eye[1] - b.view.eye[1], a.view.eye[2] - b.view.eye[2]);
@@ -123,6 +129,8 @@ export function sameView(a: ViewState, b: ViewState, epsilon = 1e-3): boolean {
     d <= epsilon &&
     dot(a.forward, b.forward) >= 1 - 1e-9 &&
     dot(a.up, b.up) >= 1 - 1e-9 &&
+    Math.abs(a.near - b.near) <= 1e-6 * Math.max(a.near, b.near) &&
+    Math.abs(a.far - b.far) <= 1e-6 * Math.max(a.far, b.far) &&
     a.view.viewportHeightPx === b.view.viewportHeightPx &&
     a.view.fovY === b.view.fovY &&
     a.params.maxPixelError === b.params.maxPixelError &&

@@ -65,6 +65,8 @@ describe('views', () => {
     params: PARAMS,
     forward,
     up: [0, 1, 0],
+    near: 10,
+    far: 1e7,
   });
 
   it('are the same within a millimetre and a hair of a turn', () => {
@@ -74,6 +76,16 @@ describe('views', () => {
     expect(sameView(a, state([6.4e6, 0, 0], [0, Math.sin(1e-3), Math.cos(1e-3)]))).toBe(false);
     expect(sameView(a, { ...a, params: { ...PARAMS, maxPixelError: 4 } })).toBe(false);
     expect(sameView(a, { ...a, view: { ...a.view, viewportHeightPx: 700 } })).toBe(false);
+  });
+
+  it('differ when the clip distances do (regression: the ground under a camera teleported down was never loaded)', () => {
+    // After a teleport from 10 km to 100 m above the ground the first frames still clip at a
+    // tenth of the old height; the selection made then left out every chunk nearer than 1 km,
+    // and, the eye and directions unchanged, was taken as current once the near plane followed.
+    const a = state([6.4e6, 0, 0], [0, 0, 1]);
+    expect(sameView(a, { ...a, near: 1000 })).toBe(false);
+    expect(sameView(a, { ...a, far: 2e7 })).toBe(false);
+    expect(sameView(a, { ...a, near: 10 * (1 + 1e-9) })).toBe(true);
   });
 
   it('move frustum planes from the render frame to the planet frame exactly, at Earth radius', () => {

@@ -92,7 +92,7 @@ pub struct EditArgs {
 /// is created, and must agree with the world file when given for an existing one.
 #[derive(Args, Debug, Clone, Default)]
 pub struct WorldPlanetArgs {
-    /// Terrain preset of a new world: sphere, earthlike, moon or mars [default: earthlike].
+    /// Terrain preset of a new world: sphere, earthlike, moon, mars or earth [default: earthlike].
     #[arg(long, value_parser = parse_preset)]
     preset: Option<PresetKind>,
 
@@ -100,23 +100,23 @@ pub struct WorldPlanetArgs {
     #[arg(long)]
     seed: Option<u64>,
 
-    /// n_c of a new world: chunks along each side of a cube face [default: 8].
+    /// n_c of a new world: chunks along each side of a cube face [default: the preset's layout].
     #[arg(long = "n-c", value_name = "N")]
     n_c: Option<u32>,
 
-    /// n_t of a new world: tiles along each side of a chunk, 1..=128 [default: 32].
+    /// n_t of a new world: tiles along each side of a chunk, 1..=128 [default: the preset's layout].
     #[arg(long = "n-t", value_name = "N")]
     n_t: Option<u32>,
 
-    /// d_b of a new world: radius in metres of the innermost voxel layer [default: 1744].
+    /// d_b of a new world: radius in metres of the innermost voxel layer [default: the preset's layout].
     #[arg(long = "d-b", value_name = "METRES", allow_negative_numbers = true)]
     d_b: Option<f64>,
 
-    /// l_d of a new world: radial tile length in metres [default: 4].
+    /// l_d of a new world: radial tile length in metres [default: the preset's layout].
     #[arg(long = "l-d", value_name = "METRES", allow_negative_numbers = true)]
     l_d: Option<f64>,
 
-    /// d_c of a new world: chunks along the depth axis [default: 2].
+    /// d_c of a new world: chunks along the depth axis [default: the preset's layout].
     #[arg(long = "d-c", value_name = "N")]
     d_c: Option<u32>,
 }
