@@ -4,7 +4,8 @@
 //!   Positive density is solid, the surface is at zero.
 //! - [`noise`]: fractal 3D gradient noise in `f64`, sampled on the sphere (seed 000 Sec. 4.6).
 //! - [`presets`]: terrains with continents, mountains, seas, caves and overhangs.
-#![forbid(unsafe_code)]
+// `unsafe` only in the vector noise kernel (`noise::lanes`), behind a run-time feature check.
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 mod density;

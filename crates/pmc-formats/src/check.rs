@@ -74,7 +74,7 @@ fn check_mesh(m: &ChunkMesh) -> Result<bool, String> {
             ));
         }
     }
-    if m.indices.len() % 3 != 0 {
+    if !m.indices.len().is_multiple_of(3) {
         return Err(format!("indices has {} entries, not a multiple of 3", m.indices.len()));
     }
     if let Some((at, &i)) = m.indices.iter().enumerate().find(|&(_, &i)| i as usize >= n) {

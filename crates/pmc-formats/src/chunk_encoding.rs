@@ -207,7 +207,7 @@ pub fn encoded_len(v: u64, i: u64) -> u64 {
 
 /// Appends zero bytes to `out` until its length (counted from `start`) is a multiple of 4.
 fn pad_to_4(out: &mut Vec<u8>, start: usize) {
-    while (out.len() - start) % 4 != 0 {
+    while !(out.len() - start).is_multiple_of(4) {
         out.push(0);
     }
 }
@@ -380,7 +380,7 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
     let origin = DVec3::new(r.f64(), r.f64(), r.f64());
     let v32 = r.u32();
     let i32_ = r.u32();
-    if i32_ % 3 != 0 {
+    if !i32_.is_multiple_of(3) {
         return Err(ChunkDecodeError::IndexCount(i32_));
     }
     if u32_flag != (v32 as usize > MAX_U16_VERTICES) {

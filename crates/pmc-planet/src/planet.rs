@@ -383,7 +383,7 @@ impl Planet {
         scratch.densities.resize(grid.sample_count(), 0.0);
         self.sample(key, &grid, &mut scratch.densities);
         close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
-        let sides: Vec<(ChunkSide, Vec<DVec3>)> = if self.layout.n_t() % 2 == 0 {
+        let sides: Vec<(ChunkSide, Vec<DVec3>)> = if self.layout.n_t().is_multiple_of(2) {
             coarser
                 .sides()
                 .filter_map(|side| {

@@ -168,7 +168,7 @@ pub fn render(meshes: &[ChunkMesh], camera: &Camera, opts: &RenderOptions) -> Re
 /// Index buffer checks: a whole number of triangles, every index names a vertex.
 fn check_mesh(i: usize, m: &ChunkMesh) -> Result<(), RenderError> {
     let bad = |reason: String| Err(RenderError::Mesh { mesh: i, reason });
-    if m.indices.len() % 3 != 0 {
+    if !m.indices.len().is_multiple_of(3) {
         return bad(format!(
             "{} indices is not a whole number of triangles",
             m.indices.len()

@@ -557,7 +557,7 @@ fn integrity_check_passes_after_normal_use_and_two_handles_share_a_world() {
     let mut b = World::open(&p).unwrap();
     let mut rng = Rng(11);
     for i in 0..300u32 {
-        let w = if rng.next() % 2 == 0 { &mut a } else { &mut b };
+        let w = if rng.next().is_multiple_of(2) { &mut a } else { &mut b };
         match rng.next() % 6 {
             0 => {
                 w.undo().unwrap();

@@ -2,6 +2,7 @@
 //! amplitude.
 
 use super::gradient::gradient3;
+use super::lanes::{gradient3_x8, Lanes8, BATCH_FROM, LANES};
 use super::octave::{table, Octave, MAX_OCTAVES};
 use pmc_geometry::glam::DVec3;
 
@@ -83,9 +84,24 @@ impl Fbm {
     /// The value at `p`, in `[-1, 1]`.
     #[inline]
     pub fn sample(&self, p: DVec3) -> f64 {
+        let octaves = &self.octaves[..self.count];
         let mut sum = 0.0;
-        for o in &self.octaves[..self.count] {
-            sum += o.amplitude * gradient3(p * o.frequency + o.offset, o.seed);
+        if octaves.len() >= BATCH_FROM {
+            // The octaves' noise eight at a time (the same bits), summed in order.
+            for group in octaves.chunks(LANES) {
+                let mut q = Lanes8::default();
+                for (l, o) in group.iter().enumerate() {
+                    q.set(l, p * o.frequency + o.offset, o.seed);
+                }
+                let n = gradient3_x8(&q);
+                for (o, n) in group.iter().zip(n) {
+                    sum += o.amplitude * n;
+                }
+            }
+        } else {
+            for o in octaves {
+                sum += o.amplitude * gradient3(p * o.frequency + o.offset, o.seed);
+            }
         }
         sum * self.norm
     }
@@ -99,6 +115,24 @@ mod tests {
         (0..n * n * n).map(move |i| {
             DVec3::new((i % n) as f64, ((i / n) % n) as f64, (i / (n * n)) as f64) * step + DVec3::splat(0.123)
         })
+    }
+
+    #[test]
+    fn batched_octaves_give_the_scalar_sum_bit_for_bit() {
+        for octaves in [1, 3, 4, 7, 8, 9, 16] {
+            let f = Fbm::new(9, FbmParams::new(1.7, octaves));
+            for p in grid(12, 0.731).map(|p| p * 1.0e4 + DVec3::new(6.4e6, -3.0e5, 1.0)) {
+                let mut want = 0.0;
+                for o in &f.octaves[..f.count] {
+                    want += o.amplitude * gradient3(p * o.frequency + o.offset, o.seed);
+                }
+                assert_eq!(
+                    f.sample(p).to_bits(),
+                    (want * f.norm).to_bits(),
+                    "{octaves} octaves at {p:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -28,17 +28,17 @@ use pmc_geometry::glam::DVec3;
 pub const GRADIENT_RAW_MAX: f64 = 1.036_353_811_211_803;
 
 /// Scale applied to the raw value so that the output lies in `[-1, 1]`.
-const SCALE: f64 = 1.0 / GRADIENT_RAW_MAX;
+pub(super) const SCALE: f64 = 1.0 / GRADIENT_RAW_MAX;
 
 /// Gradient components indexed by the top four hash bits: the twelve cube-edge directions, then
 /// four of them again (a regular tetrahedron, so the repeats add no directional bias on average).
-const GX: [f64; 16] = [1., -1., 1., -1., 1., -1., 1., -1., 0., 0., 0., 0., 1., -1., 0., 0.];
-const GY: [f64; 16] = [1., 1., -1., -1., 0., 0., 0., 0., 1., -1., 1., -1., 1., 1., -1., -1.];
-const GZ: [f64; 16] = [0., 0., 0., 0., 1., 1., -1., -1., 1., 1., -1., -1., 0., 0., 1., -1.];
+pub(super) const GX: [f64; 16] = [1., -1., 1., -1., 1., -1., 1., -1., 0., 0., 0., 0., 1., -1., 0., 0.];
+pub(super) const GY: [f64; 16] = [1., 1., -1., -1., 0., 0., 0., 0., 1., -1., 1., -1., 1., 1., -1., -1.];
+pub(super) const GZ: [f64; 16] = [0., 0., 0., 0., 1., 1., -1., -1., 1., 1., -1., -1., 0., 0., 1., -1.];
 
 /// `1.5 * 2^52`: adding it to a double of magnitude below `2^51` rounds to an integer, whose
 /// value then sits in the low mantissa bits.
-const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
+pub(super) const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
 
 /// Splits `x` into its lattice cell `floor(x)` and the fraction `x - floor(x)` in `[0, 1]`.
 ///

@@ -2,6 +2,7 @@
 //! detail on the crests than in the valleys.
 
 use super::gradient::gradient3;
+use super::lanes::{gradient3_x8, Lanes8, BATCH_FROM, LANES};
 use super::octave::{table, Octave, MAX_OCTAVES};
 use super::{DEFAULT_FREQUENCY, DEFAULT_GAIN, DEFAULT_LACUNARITY, DEFAULT_OCTAVES};
 use pmc_geometry::glam::DVec3;
@@ -89,14 +90,30 @@ impl Ridged {
     /// The value at `p`, in `[0, 1]`.
     #[inline]
     pub fn sample(&self, p: DVec3) -> f64 {
+        let octaves = &self.octaves[..self.count];
         let mut sum = 0.0;
         let mut weight = 1.0;
-        for o in &self.octaves[..self.count] {
-            let n = gradient3(p * o.frequency + o.offset, o.seed);
+        let mut add = |o: &Octave, n: f64| {
             let s = self.params.offset - n.abs();
             let s = s * s * weight;
             weight = (s * self.params.feedback).clamp(0.0, 1.0);
             sum += s * o.amplitude;
+        };
+        if octaves.len() >= BATCH_FROM {
+            // The octaves' noise eight at a time (the same bits; the weights only scale it).
+            for group in octaves.chunks(LANES) {
+                let mut q = Lanes8::default();
+                for (l, o) in group.iter().enumerate() {
+                    q.set(l, p * o.frequency + o.offset, o.seed);
+                }
+                for (o, n) in group.iter().zip(gradient3_x8(&q)) {
+                    add(o, n);
+                }
+            }
+        } else {
+            for o in octaves {
+                add(o, gradient3(p * o.frequency + o.offset, o.seed));
+            }
         }
         sum * self.norm
     }
@@ -105,6 +122,36 @@ impl Ridged {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn batched_octaves_give_the_scalar_sum_bit_for_bit() {
+        for octaves in [2, 4, 6, 9, 16] {
+            let r = Ridged::new(
+                4,
+                RidgedParams {
+                    octaves,
+                    ..RidgedParams::default()
+                },
+            );
+            for i in 0..500 {
+                let t = f64::from(i);
+                let p = DVec3::new(6.4e6 + t * 3.7, -t * 0.91, 1.0e3 + t * t * 0.013);
+                let (mut want, mut weight) = (0.0, 1.0);
+                for o in &r.octaves[..r.count] {
+                    let n = gradient3(p * o.frequency + o.offset, o.seed);
+                    let s = r.params.offset - n.abs();
+                    let s = s * s * weight;
+                    weight = (s * r.params.feedback).clamp(0.0, 1.0);
+                    want += s * o.amplitude;
+                }
+                assert_eq!(
+                    r.sample(p).to_bits(),
+                    (want * r.norm).to_bits(),
+                    "{octaves} octaves at {p:?}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn bounded_deterministic_and_seeded() {

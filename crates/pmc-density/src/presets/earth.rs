@@ -42,13 +42,17 @@
 //! computes the same bits for it. A batch advances each column's ladder only as far as its
 //! furthest-reaching radius needs: a chunk kilometres from the surface costs a few coarse
 //! octaves per column; a chunk at the surface evaluates the whole ladder once per column and
-//! the 3D terms only in the band around the surface.
+//! the 3D terms only in the band around the surface. The ladder's noise is evaluated for the
+//! next eight entries that count at once ([`crate::noise::gradient3_x8`]): the same bits as one
+//! at a time.
 
 use super::features::{lerp, smoothstep, CaveBand, Scales, Spaghetti, Stretch};
 use super::layouts::EARTH_RADIUS;
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
-use crate::noise::{derive_seed, gradient3, mix64, unit_f64, Fbm, FbmParams, DEFAULT_LACUNARITY};
+use crate::noise::{
+    derive_seed, gradient3, gradient3_x8, mix64, unit_f64, Fbm, FbmParams, Lanes8, DEFAULT_LACUNARITY, LANES,
+};
 use crate::Density;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
@@ -169,8 +173,6 @@ struct Entry {
 pub(crate) struct EarthColumn {
     /// Per-part amplitude factors in metres (Regional, Hills, Ridge = mountain height, Rocks).
     factor: [f64; 4],
-    /// Mountain mask in `[0, 1]`.
-    pub mountains: f64,
     /// 3D rock and cliff amplitudes (metres).
     a_rock: f64,
     a_cliff: f64,
@@ -191,6 +193,12 @@ pub(crate) struct EarthColumn {
     keep_hi: [f64; MAX_ENTRIES + 1],
     /// The bound on the remaining octaves after `k` entries.
     rem: [f64; MAX_ENTRIES + 1],
+    /// Noise of upcoming entries, evaluated eight at a time: `noise[l]` is entry `noise_of[l]`'s
+    /// (`usize::MAX`: none).
+    noise: [f64; LANES],
+    noise_of: [usize; LANES],
+    /// The lane of the next entry asked for (entries are asked for in increasing order).
+    noise_next: usize,
 }
 
 impl EarthColumn {
@@ -206,6 +214,16 @@ impl EarthColumn {
     }
 }
 
+/// The height-independent fields of a column (see [`EarthModel::surface_fields`]).
+struct SurfaceFields {
+    mountains: f64,
+    on_land: f64,
+    a_rock: f64,
+    a_cliff: f64,
+    cave_gate: f64,
+    roof: f64,
+}
+
 /// The earth density model.
 pub(crate) struct EarthModel {
     s: Scales,
@@ -219,8 +237,8 @@ pub(crate) struct EarthModel {
     belts: Fbm,
     hilliness_seed: u64,
     entries: Vec<Entry>,
-    /// `suffix[p][k]`: the sum of the amplitudes of part `p` from entry `k` on.
-    suffix: [Vec<f64>; 4],
+    /// `sums[k][p]`: the sum of the amplitudes of part `p` from entry `k` on.
+    sums: Vec<[f64; 4]>,
     cliff_seed: u64,
     cliff_freq: f64,
     rock3d: Stretch,
@@ -253,6 +271,9 @@ impl EarthModel {
                 sums[k] = sums[k + 1] + if e.part as usize == p { e.amp } else { 0.0 };
             }
         }
+        let sums = (0..=entries.len())
+            .map(|k| [0, 1, 2, 3].map(|p| suffix[p][k]))
+            .collect();
         let l_d = s.l_d;
         let rock3d_amp = (ROCK3D_AMP * l_d).min(ROCK3D_CAP * t);
         let cliff_amp = (CLIFF_AMP * l_d).min(CLIFF_CAP * t);
@@ -295,7 +316,7 @@ impl EarthModel {
             belts: Fbm::new(derive_seed(seed, 45), FbmParams::new(BELT_FREQ, 2)),
             hilliness_seed: derive_seed(seed, 46),
             entries,
-            suffix,
+            sums,
             cliff_seed: derive_seed(seed, 47),
             cliff_freq: s.freq(CLIFF_REGION * s.tile),
             rock3d: Stretch::new(ROCK3D_ACROSS * s.tile, (ROCK3D_DEEP * l_d).min(0.25 * t), sea),
@@ -325,9 +346,57 @@ impl EarthModel {
     }
 
     /// The coarse fields of the column along unit direction `dir` (no ladder entry evaluated).
+    /// The continental value along unit direction `dir` (its sign tells land from sea).
+    #[inline]
+    fn continent(&self, dir: DVec3) -> f64 {
+        self.continents.sample(dir) + CONT_BIAS
+    }
+
+    /// The fields of the column along `dir` (continental value `e`) that do not depend on its
+    /// height: the mountain mask and the amplitudes of the 3D terms. The shader needs only these
+    /// (and the height in cave regions).
+    #[inline]
+    fn surface_fields(&self, dir: DVec3, e: f64) -> SurfaceFields {
+        // Mountain belts along a noise zero set.
+        let land_gate = smoothstep(0.005, 0.05, e);
+        let mountains = if land_gate > 0.0 {
+            (1.0 - smoothstep(0.015, 0.07, self.belts.sample(dir).abs())) * land_gate
+        } else {
+            0.0
+        };
+        let on_land = smoothstep(-0.015, 0.01, e);
+        // 3D terms: rock bumps on land, cliffs in parts of the mountains, caves in regions of the
+        // land whose roof opens in places.
+        let a_rock = self.rock3d_amp * on_land;
+        let a_cliff = if mountains > 0.0 {
+            self.cliff_amp * mountains * smoothstep(-0.1, 0.3, gradient3(dir * self.cliff_freq, self.cliff_seed))
+        } else {
+            0.0
+        };
+        let cave_land = smoothstep(0.0, 0.015, e);
+        let (cave_gate, roof) = if cave_land > 0.0 {
+            let region = gradient3(dir * self.region_freq, self.region_seed);
+            let mouth = smoothstep(0.25, 0.45, region);
+            (
+                cave_land * smoothstep(-0.15, 0.05, region),
+                self.s.l_d * (CAVE_ROOF - (CAVE_ROOF + CAVE_MOUTH) * mouth),
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        SurfaceFields {
+            mountains,
+            on_land,
+            a_rock,
+            a_cliff,
+            cave_gate,
+            roof,
+        }
+    }
+
     pub(crate) fn column(&self, dir: DVec3) -> EarthColumn {
         let v = self.vert;
-        let e = self.continents.sample(dir) + CONT_BIAS;
+        let e = self.continent(dir);
         // Ocean: a shelf, then the abyssal floor (its depth varying between basins), and trenches
         // along part of a noise zero set. Every noise is skipped where its factor is exactly zero.
         let shelf = smoothstep(0.0, 0.012, -e);
@@ -351,16 +420,17 @@ impl EarthModel {
         if plateau_gate > 0.0 {
             height += PLATEAU_HEIGHT * plateau_gate * smoothstep(0.1, 0.45, self.plateaus.sample(dir));
         }
-        let land_gate = smoothstep(0.005, 0.05, e);
-        let mountains = if land_gate > 0.0 {
-            (1.0 - smoothstep(0.015, 0.07, self.belts.sample(dir).abs())) * land_gate
-        } else {
-            0.0
-        };
+        let SurfaceFields {
+            mountains,
+            on_land,
+            a_rock,
+            a_cliff,
+            cave_gate,
+            roof,
+        } = self.surface_fields(dir, e);
         let base = self.sea + v * (height - depth);
         // Detail amplitudes: hills rougher where the hilliness noise is high and in mountains,
         // calmer at sea; rocks rougher in the mountains.
-        let on_land = smoothstep(-0.015, 0.01, e);
         let hilly = lerp(
             0.35,
             1.7,
@@ -372,25 +442,6 @@ impl EarthModel {
             v * MOUNTAIN_HEIGHT * mountains,
             v * lerp(0.3, 0.7 + mountains, on_land),
         ];
-        // 3D terms: rock bumps on land, cliffs in parts of the mountains, caves in regions of the
-        // land whose roof opens in places.
-        let a_rock = self.rock3d_amp * on_land;
-        let a_cliff = if mountains > 0.0 {
-            self.cliff_amp * mountains * smoothstep(-0.1, 0.3, gradient3(dir * self.cliff_freq, self.cliff_seed))
-        } else {
-            0.0
-        };
-        let cave_land = smoothstep(0.0, 0.015, e);
-        let (cave_gate, roof) = if cave_land > 0.0 {
-            let region = gradient3(dir * self.region_freq, self.region_seed);
-            let mouth = smoothstep(0.25, 0.45, region);
-            (
-                cave_land * smoothstep(-0.15, 0.05, region),
-                self.s.l_d * (CAVE_ROOF - (CAVE_ROOF + CAVE_MOUTH) * mouth),
-            )
-        } else {
-            (0.0, 0.0)
-        };
         let a = a_rock + a_cliff;
         let over = if a > 0.0 { 1.5 * a + self.falloff } else { 0.0 };
         let (cave_down, cave_up) = if cave_gate > 0.0 {
@@ -408,7 +459,6 @@ impl EarthModel {
         let margin = self.s.l_d + 1e-6 * self.s.thickness;
         let mut col = EarthColumn {
             factor,
-            mountains,
             a_rock,
             a_cliff,
             cave_gate,
@@ -423,6 +473,9 @@ impl EarthModel {
             keep_lo: [0.0; MAX_ENTRIES + 1],
             keep_hi: [0.0; MAX_ENTRIES + 1],
             rem: [0.0; MAX_ENTRIES + 1],
+            noise: [0.0; LANES],
+            noise_of: [usize::MAX; LANES],
+            noise_next: LANES,
         };
         col.h[0] = base;
         self.set_keep(&mut col, 0, f64::NEG_INFINITY, f64::INFINITY);
@@ -433,11 +486,9 @@ impl EarthModel {
     #[inline]
     fn set_keep(&self, col: &mut EarthColumn, k: usize, lo: f64, hi: f64) {
         let f = &col.factor;
-        let ridge_left = self.suffix[Part::Ridge as usize][k];
-        let rem = f[0] * self.suffix[0][k]
-            + f[1] * self.suffix[1][k]
-            + f[3] * self.suffix[3][k]
-            + f[2] * ridge_left * (2.0 * col.ridge + ridge_left);
+        let sums = &self.sums[k];
+        let ridge_left = sums[Part::Ridge as usize];
+        let rem = f[0] * sums[0] + f[1] * sums[1] + f[3] * sums[3] + f[2] * ridge_left * (2.0 * col.ridge + ridge_left);
         let h = col.h[k];
         col.rem[k] = rem;
         col.keep_lo[k] = lo.max(h - (rem + col.w_down).max(STOP_FACTOR * rem));
@@ -450,7 +501,7 @@ impl EarthModel {
         let e = &self.entries[k];
         let f = col.factor[e.part as usize];
         if f > 0.0 {
-            let n = gradient3(dir * e.freq + e.offset, e.seed);
+            let n = self.ladder_noise(col, dir, k);
             match e.part {
                 Part::Ridge => {
                     let s = (1.0 - n.abs()) * (1.0 - n.abs()) * col.weight;
@@ -464,6 +515,36 @@ impl EarthModel {
         col.h[k + 1] = col.linear + col.factor[Part::Ridge as usize] * col.ridge * col.ridge;
         let (lo, hi) = (col.keep_lo[k], col.keep_hi[k]);
         self.set_keep(col, k + 1, lo, hi);
+    }
+
+    /// The noise of ladder entry `k` of `col` (`gradient3(dir * freq + offset, seed)`, the same
+    /// bits), evaluated with the next entries that count for the column (a non-zero factor),
+    /// eight at a time, on the first call that needs one of them.
+    #[inline]
+    fn ladder_noise(&self, col: &mut EarthColumn, dir: DVec3, k: usize) -> f64 {
+        // The lanes hold the entries that count in increasing order, and entries are asked for
+        // in increasing order: the next lane is the one, unless the lanes are used up.
+        let l = col.noise_next;
+        if l < LANES && col.noise_of[l] == k {
+            col.noise_next = l + 1;
+            return col.noise[l];
+        }
+        let mut q = Lanes8::default();
+        let mut l = 0;
+        for (j, e) in self.entries.iter().enumerate().skip(k) {
+            if l == LANES {
+                break;
+            }
+            if col.factor[e.part as usize] > 0.0 {
+                q.set(l, dir * e.freq + e.offset, e.seed);
+                col.noise_of[l] = j;
+                l += 1;
+            }
+        }
+        col.noise_of[l..].fill(usize::MAX);
+        col.noise = gradient3_x8(&q);
+        col.noise_next = 1;
+        col.noise[0]
     }
 
     /// Refines `col` until a sample at `r` stops (or the ladder ends).
@@ -729,12 +810,12 @@ impl EarthShader {
         let (l_d, tile, v) = (m.s.l_d, m.s.tile, m.vert);
         let r = p.length();
         let dir = if r > 0.0 { p / r } else { DVec3::Y };
-        let mut col = m.column(dir);
+        let f = m.surface_fields(dir, m.continent(dir));
         // Cave rock: well under the height field. Rock bumps and cliffs move the surface by at
         // most `a_rock + a_cliff`, less than the threshold, so only carved caves get there:
         // columns without caves need no height at all.
-        let cave_depth = (1.5 * l_d).max(col.a_rock + col.a_cliff + l_d);
-        if col.cave_gate > 0.0 && m.deeper_than(&mut col, dir, r, cave_depth) {
+        let cave_depth = (1.5 * l_d).max(f.a_rock + f.a_cliff + l_d);
+        if f.cave_gate > 0.0 && m.deeper_than(&mut m.column(dir), dir, r, cave_depth) {
             return CAVE;
         }
         // Heights above the sea: in layout metres for the shore, in true-scale metres for the
@@ -763,7 +844,7 @@ impl EarthShader {
             return SAND;
         }
         if zt > TREE_LINE * snow {
-            return if col.mountains > 0.3 { ROCK } else { GRASS };
+            return if f.mountains > 0.3 { ROCK } else { GRASS };
         }
         if lat2 > 0.78 {
             return GRASS;
