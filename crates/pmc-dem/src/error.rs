@@ -1,0 +1,248 @@
+//! Why a file could not be read as an elevation model.
+
+/// A failure to read an elevation model. Each variant names the file (the path as given to
+/// [`EquirectDem::read_netcdf`](crate::EquirectDem::read_netcdf), or the name given to
+/// [`EquirectDem::from_netcdf_bytes`](crate::EquirectDem::from_netcdf_bytes)), says what is wrong
+/// and what to do about it.
+///
+/// Every check that can be made from the header is made before any grid data are read or any
+/// memory is reserved for them.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DemError {
+    /// The operating system refused to open or read the file (missing, unreadable, a directory).
+    /// Fix: check the path and its permissions.
+    #[error("{file}: cannot read the file: {source}; check the path and its permissions")]
+    Io {
+        /// The file.
+        file: String,
+        /// The system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not a netCDF classic file: it is empty, it does not start with the signature
+    /// `CDF` followed by version byte 1 (classic) or 2 (64-bit offset), or it is a netCDF-4 (HDF5)
+    /// or CDF-5 file, which this reader does not support. Fix: check the path; convert netCDF-4 or
+    /// CDF-5 files with `nccopy -k classic IN OUT`.
+    #[error("{file}: not a netCDF classic file: {detail}")]
+    NotNetcdf {
+        /// The file.
+        file: String,
+        /// What was found instead, and how to convert it if that is possible.
+        detail: String,
+    },
+    /// The file is shorter than its header says: its header lists more bytes (of header or of
+    /// data) than the file holds. Usually an interrupted copy or download; a damaged header that
+    /// announces absurd sizes reads the same. Fix: copy or download the file again.
+    #[error(
+        "{file}: the file is shorter than its header says: at least {expected} bytes are needed but it holds {actual}; it was cut short (an interrupted copy or download) or its header is damaged: copy it again"
+    )]
+    Truncated {
+        /// The file.
+        file: String,
+        /// The smallest size, in bytes, that the header requires.
+        expected: u64,
+        /// The size of the file, in bytes.
+        actual: u64,
+    },
+    /// The header is longer than [`MAX_HEADER_BYTES`](crate::MAX_HEADER_BYTES); refused before it
+    /// is decoded. Headers are normally a few kilobytes; a huge attribute (a long `history`, say)
+    /// is the usual cause. Fix: delete that attribute (for instance with NCO's `ncatted -a
+    /// history,global,d,, IN OUT`).
+    #[error(
+        "{file}: the netCDF header holds at least {size} bytes, more than the {limit} this reader accepts; a huge attribute (such as a long history) is the usual cause: delete it, for instance with `ncatted -a history,global,d,, IN OUT`"
+    )]
+    HeaderTooLarge {
+        /// The file.
+        file: String,
+        /// Bytes of header seen before refusing.
+        size: u64,
+        /// The largest header accepted.
+        limit: u64,
+    },
+    /// The header is damaged: a negative count, an unknown data type, a variable over a dimension
+    /// that does not exist, an invalid name, data that start inside the header. Fix: obtain an
+    /// intact copy of the file.
+    #[error("{file}: the netCDF header is damaged: {detail}; obtain an intact copy of the file")]
+    Corrupt {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// No variable was named and the file has no variable that can be the grid: a 2-D numeric
+    /// (byte, short, int, float or double) variable whose two dimensions each have a coordinate
+    /// variable. Lists the variables found. Fix: check that the file is a gridded elevation model,
+    /// or name the variable to read.
+    #[error(
+        "{file}: no elevation grid found (a 2-D numeric variable whose two dimensions have coordinate variables); the file holds: {}",
+        list(.variables)
+    )]
+    NoGridVariable {
+        /// The file.
+        file: String,
+        /// Every variable of the file, as `NAME(DIM, ...) TYPE`.
+        variables: Vec<String>,
+    },
+    /// No variable was named and the file has several variables that could be the grid. Fix: name
+    /// the one to read.
+    #[error("{file}: several variables could be the elevation grid ({}); name the one to read", list(.candidates))]
+    AmbiguousVariable {
+        /// The file.
+        file: String,
+        /// The candidates, as `NAME(DIM, DIM) TYPE`.
+        candidates: Vec<String>,
+    },
+    /// The variable named by the caller does not exist in the file. Fix: name one of those listed.
+    #[error("{file}: no variable named {name:?}; the file holds: {}", list(.variables))]
+    VariableNotFound {
+        /// The file.
+        file: String,
+        /// The name that was asked for.
+        name: String,
+        /// Every variable of the file, as `NAME(DIM, ...) TYPE`.
+        variables: Vec<String>,
+    },
+    /// The variable named by the caller cannot be a grid: it does not have exactly two
+    /// dimensions, it holds characters, or its `scale_factor` or `add_offset` is not a finite
+    /// number. Fix: name another variable.
+    #[error("{file}: variable {name:?} cannot be read as an elevation grid: {reason}")]
+    UnsuitableVariable {
+        /// The file.
+        file: String,
+        /// The variable.
+        name: String,
+        /// Why not.
+        reason: String,
+    },
+    /// A dimension of the grid has no coordinate variable (a 1-D numeric variable over that
+    /// dimension, by convention of the same name), so its longitudes or latitudes are unknown.
+    /// Fix: add the coordinate variable to the file (for instance with NCO's `ncap2`).
+    #[error(
+        "{file}: dimension {dimension:?} of variable {variable:?} has no coordinate variable (a 1-D numeric variable over it), so its positions are unknown"
+    )]
+    MissingAxis {
+        /// The file.
+        file: String,
+        /// The grid variable.
+        variable: String,
+        /// The dimension without a coordinate variable.
+        dimension: String,
+    },
+    /// A coordinate variable is neither increasing nor decreasing: value `index` repeats or
+    /// reverses the direction of the values before it. Fix: the file is not a regular grid;
+    /// resample it onto one (for instance with GDAL's `gdalwarp`).
+    #[error(
+        "{file}: the {axis} axis is not monotonic: value {index} does not continue the direction of the values before it; resample the grid onto a regular one"
+    )]
+    AxisNotMonotonic {
+        /// The file.
+        file: String,
+        /// The axis, as `longitude (VAR)` or `latitude (VAR)`.
+        axis: String,
+        /// The index of the first offending value.
+        index: usize,
+    },
+    /// A coordinate variable is not evenly spaced: value `index` departs from the straight line
+    /// through the first and last values by more than a millionth of a step (plus the rounding of
+    /// the values' storage type). Fix: resample the grid onto a regular one.
+    #[error(
+        "{file}: the {axis} axis is not evenly spaced: value {index} is {found:?} where even steps give {expected:?}; resample the grid onto a regular one"
+    )]
+    AxisUneven {
+        /// The file.
+        file: String,
+        /// The axis, as `longitude (VAR)` or `latitude (VAR)`.
+        axis: String,
+        /// The index of the first offending value.
+        index: usize,
+        /// The value that even spacing gives at `index`.
+        expected: f64,
+        /// The value found in the file.
+        found: f64,
+    },
+    /// A coordinate variable cannot describe a grid axis: it has fewer than two values, a value
+    /// that is not a finite number, or longitudes that span more than 360 degrees. Fix: check
+    /// the file; crop an overlapping grid to one turn.
+    #[error("{file}: the {axis} axis is unusable: {detail}")]
+    AxisInvalid {
+        /// The file.
+        file: String,
+        /// The axis, as `longitude (VAR)` or `latitude (VAR)`.
+        axis: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// A latitude lies outside [-90, 90] degrees. Fix: check which variable holds the latitudes
+    /// (the axes may be swapped or not in degrees).
+    #[error(
+        "{file}: the {axis} axis holds latitude {value:?}, outside [-90, 90] degrees; check that the axis is a latitude in degrees"
+    )]
+    LatitudeOutOfRange {
+        /// The file.
+        file: String,
+        /// The axis, as `latitude (VAR)`.
+        axis: String,
+        /// The offending latitude.
+        value: f64,
+    },
+    /// The grid has more cells than this reader accepts; refused before anything is allocated.
+    /// Fix: crop or subsample the file (for instance with `ncks -d`).
+    #[error(
+        "{file}: the grid is {width} x {height} cells, more than the {limit} this reader accepts; crop or subsample it"
+    )]
+    TooLarge {
+        /// The file.
+        file: String,
+        /// Number of columns (longitudes) declared.
+        width: u64,
+        /// Number of rows (latitudes) declared.
+        height: u64,
+        /// The largest number of cells accepted ([`MAX_CELLS`](crate::MAX_CELLS)).
+        limit: u64,
+    },
+    /// Every sample of the grid is missing: equal to the fill or missing value, or not a finite
+    /// number. Fix: check that the right variable was read and that the file was written fully.
+    #[error(
+        "{file}: variable {variable:?} holds no valid sample: every value is the fill or missing value or not a number"
+    )]
+    NoValidData {
+        /// The file.
+        file: String,
+        /// The variable read.
+        variable: String,
+    },
+}
+
+/// The names in `items`, separated by commas, or `no variables` when there are none.
+fn list(items: &[String]) -> String {
+    if items.is_empty() {
+        "no variables".to_owned()
+    } else {
+        items.join(", ")
+    }
+}
+
+impl DemError {
+    /// The file the error is about, as named in its message.
+    pub fn file(&self) -> &str {
+        match self {
+            DemError::Io { file, .. }
+            | DemError::NotNetcdf { file, .. }
+            | DemError::Truncated { file, .. }
+            | DemError::HeaderTooLarge { file, .. }
+            | DemError::Corrupt { file, .. }
+            | DemError::NoGridVariable { file, .. }
+            | DemError::AmbiguousVariable { file, .. }
+            | DemError::VariableNotFound { file, .. }
+            | DemError::UnsuitableVariable { file, .. }
+            | DemError::MissingAxis { file, .. }
+            | DemError::AxisNotMonotonic { file, .. }
+            | DemError::AxisUneven { file, .. }
+            | DemError::AxisInvalid { file, .. }
+            | DemError::LatitudeOutOfRange { file, .. }
+            | DemError::TooLarge { file, .. }
+            | DemError::NoValidData { file, .. } => file,
+        }
+    }
+}

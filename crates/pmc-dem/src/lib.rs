@@ -1,0 +1,47 @@
+//! Digital elevation models on equirectangular grids, read from netCDF classic files: heights in
+//! metres at evenly spaced longitudes and latitudes, with bilinear sampling that wraps round the
+//! globe.
+//!
+//! [`EquirectDem::read_netcdf`] reads a netCDF classic (CDF-1) or 64-bit offset (CDF-2) file such
+//! as NOAA's ETOPO relief grids. The file's coordinate variables give the axes; the result is
+//! normalised to one layout (rows from south to north, columns from west to east, the first
+//! longitude in [-180, 180), a column repeated one turn later dropped) whatever the file's order.
+//! Input from outside is checked before it is trusted: every problem is a [`DemError`] naming the
+//! file, never a panic, and sizes are checked against the file before memory is reserved.
+//!
+//! ```
+//! use pmc_dem::EquirectDem;
+//!
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/etopo60.cdf");
+//! let dem = EquirectDem::read_netcdf(&path, None)?; // the variable ROSE, found by shape
+//! assert_eq!((dem.width(), dem.height()), (360, 180)); // one-degree cells
+//! assert_eq!((dem.lon(0), dem.lat(0)), (20.5, -89.5)); // cell centres, from the south-west
+//! assert!(dem.wraps_in_longitude());
+//!
+//! // Interpolated heights, in metres; any longitude, wrapping across the antimeridian.
+//! let himalaya = dem.sample_bilinear(28.0, 87.0).unwrap();
+//! let pacific = dem.sample_bilinear(0.0, -150.0).unwrap();
+//! assert!(himalaya > 3000.0 && pacific < -3000.0);
+//! assert_eq!(dem.sample_bilinear(0.0, 210.0), Some(pacific));
+//!
+//! let stats = dem.stats();
+//! assert_eq!(stats.missing, 0);
+//! assert!(stats.min < -7000.0 && stats.max > 5000.0); // a trench, the Himalaya
+//! # Ok::<(), pmc_dem::DemError>(())
+//! ```
+//!
+//! The example `dem_info` prints what is read from a file:
+//! `cargo run --release -p pmc-dem --example dem_info -- FILE.cdf [VARIABLE]`.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+mod axis;
+mod dem;
+mod error;
+mod header;
+mod read;
+
+pub use dem::{DemStats, EquirectDem};
+pub use error::DemError;
+pub use header::MAX_HEADER_BYTES;
+pub use read::MAX_CELLS;
