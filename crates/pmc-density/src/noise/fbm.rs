@@ -1,9 +1,9 @@
 //! Fractional Brownian motion: a sum of gradient-noise octaves of rising frequency and falling
 //! amplitude.
 
+#[cfg(test)]
 use super::gradient::gradient3;
-use super::lanes::{gradient3_x8, Lanes8, BATCH_FROM, LANES};
-use super::octave::{table, Octave, MAX_OCTAVES};
+use super::octave::{octave_noise, table, Octave, MAX_OCTAVES};
 use pmc_geometry::glam::DVec3;
 
 /// Default number of octaves.
@@ -85,23 +85,11 @@ impl Fbm {
     #[inline]
     pub fn sample(&self, p: DVec3) -> f64 {
         let octaves = &self.octaves[..self.count];
+        let mut noise = [0.0; MAX_OCTAVES as usize];
+        octave_noise(octaves, p, &mut noise);
         let mut sum = 0.0;
-        if octaves.len() >= BATCH_FROM {
-            // The octaves' noise eight at a time (the same bits), summed in order.
-            for group in octaves.chunks(LANES) {
-                let mut q = Lanes8::default();
-                for (l, o) in group.iter().enumerate() {
-                    q.set(l, p * o.frequency + o.offset, o.seed);
-                }
-                let n = gradient3_x8(&q);
-                for (o, n) in group.iter().zip(n) {
-                    sum += o.amplitude * n;
-                }
-            }
-        } else {
-            for o in octaves {
-                sum += o.amplitude * gradient3(p * o.frequency + o.offset, o.seed);
-            }
+        for (o, n) in octaves.iter().zip(noise) {
+            sum += o.amplitude * n;
         }
         sum * self.norm
     }

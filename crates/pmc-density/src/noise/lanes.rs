@@ -56,8 +56,8 @@ impl Lanes8 {
 #[inline]
 pub fn gradient3_x8(q: &Lanes8) -> [f64; LANES] {
     #[cfg(target_arch = "x86_64")]
-    if x86::available() {
-        return x86::gradient3_x8(q);
+    if let Some(n) = x86::gradient3_x8(q) {
+        return n;
     }
     scalar(q)
 }
@@ -79,23 +79,23 @@ pub(crate) mod x86 {
 
     /// Whether this processor runs the kernel (AVX-512 F and DQ).
     #[inline]
-    pub(crate) fn available() -> bool {
+    fn available() -> bool {
         std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq")
     }
 
-    /// The eight evaluations in 512-bit lanes.
-    ///
-    /// # Panics
-    /// If the processor lacks AVX-512 F or DQ (check [`available`] first).
+    /// The eight evaluations in 512-bit lanes, or `None` on a processor without AVX-512 F and
+    /// DQ.
     #[inline]
-    pub(crate) fn gradient3_x8(q: &Lanes8) -> [f64; LANES] {
-        assert!(available(), "the AVX-512 noise kernel needs AVX-512 F and DQ");
+    pub(crate) fn gradient3_x8(q: &Lanes8) -> Option<[f64; LANES]> {
+        if !available() {
+            return None;
+        }
         let mut out = [0.0; LANES];
-        // SAFETY: the processor has AVX-512 F and DQ (asserted above), the only features
+        // SAFETY: the processor has AVX-512 F and DQ (checked above), the only features
         // `kernel` is compiled for; its loads and stores stay inside `q` and `out` (arrays of
         // exactly eight lanes).
         unsafe { kernel(q, &mut out) };
-        out
+        Some(out)
     }
 
     /// `(cell, fraction)` of each lane, as the scalar `split`: the `1.5 * 2^52` rounding, one

@@ -1,6 +1,8 @@
 //! The per-octave table shared by the fractal sums: frequency, amplitude, seed and offset.
 
+use super::gradient::gradient3;
 use super::hash::{derive_seed, mix64, unit_f64};
+use super::lanes::{gradient3_x8, Lanes8, BATCH_FROM, LANES};
 use pmc_geometry::glam::DVec3;
 
 /// The most octaves a fractal sum takes (more are clamped; 16 octaves at lacunarity 2 span a
@@ -51,6 +53,27 @@ pub(crate) fn table(
         a *= gain;
     }
     (out, n, total)
+}
+
+/// The noise of each octave of `octaves` at `p` (`gradient3(p f + offset, seed)`, the same
+/// bits), in `out[..octaves.len()]`: eight at a time from [`BATCH_FROM`] octaves on, else one by
+/// one. The fractal sums then combine them in order.
+#[inline]
+pub(crate) fn octave_noise(octaves: &[Octave], p: DVec3, out: &mut [f64; MAX_OCTAVES as usize]) {
+    if octaves.len() >= BATCH_FROM {
+        for (group, out) in octaves.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            let mut q = Lanes8::default();
+            for (l, o) in group.iter().enumerate() {
+                q.set(l, p * o.frequency + o.offset, o.seed);
+            }
+            let n = gradient3_x8(&q);
+            out.copy_from_slice(&n[..out.len()]);
+        }
+    } else {
+        for (o, n) in octaves.iter().zip(out.iter_mut()) {
+            *n = gradient3(p * o.frequency + o.offset, o.seed);
+        }
+    }
 }
 
 /// The number of octaves needed to go from wavelength `coarsest` down to no finer than `finest`

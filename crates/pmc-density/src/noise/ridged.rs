@@ -1,9 +1,9 @@
 //! Ridged multifractal (after Musgrave): sharp crests where the noise crosses zero, with rougher
 //! detail on the crests than in the valleys.
 
+#[cfg(test)]
 use super::gradient::gradient3;
-use super::lanes::{gradient3_x8, Lanes8, BATCH_FROM, LANES};
-use super::octave::{table, Octave, MAX_OCTAVES};
+use super::octave::{octave_noise, table, Octave, MAX_OCTAVES};
 use super::{DEFAULT_FREQUENCY, DEFAULT_GAIN, DEFAULT_LACUNARITY, DEFAULT_OCTAVES};
 use pmc_geometry::glam::DVec3;
 
@@ -91,29 +91,15 @@ impl Ridged {
     #[inline]
     pub fn sample(&self, p: DVec3) -> f64 {
         let octaves = &self.octaves[..self.count];
+        let mut noise = [0.0; MAX_OCTAVES as usize];
+        octave_noise(octaves, p, &mut noise);
         let mut sum = 0.0;
         let mut weight = 1.0;
-        let mut add = |o: &Octave, n: f64| {
+        for (o, n) in octaves.iter().zip(noise) {
             let s = self.params.offset - n.abs();
             let s = s * s * weight;
             weight = (s * self.params.feedback).clamp(0.0, 1.0);
             sum += s * o.amplitude;
-        };
-        if octaves.len() >= BATCH_FROM {
-            // The octaves' noise eight at a time (the same bits; the weights only scale it).
-            for group in octaves.chunks(LANES) {
-                let mut q = Lanes8::default();
-                for (l, o) in group.iter().enumerate() {
-                    q.set(l, p * o.frequency + o.offset, o.seed);
-                }
-                for (o, n) in group.iter().zip(gradient3_x8(&q)) {
-                    add(o, n);
-                }
-            }
-        } else {
-            for o in octaves {
-                add(o, gradient3(p * o.frequency + o.offset, o.seed));
-            }
         }
         sum * self.norm
     }

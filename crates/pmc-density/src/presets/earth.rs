@@ -718,11 +718,8 @@ impl Density for EarthDensity {
         // run of them.
         let sorted = radii.windows(2).all(|w| w[0] <= w[1]) && radii.first().is_none_or(|r| *r >= 0.0);
         for (d, dir) in dirs.iter().enumerate() {
-            let (mut r_min, mut r_max) = (f64::INFINITY, f64::NEG_INFINITY);
             for (x, r) in rs.iter_mut().zip(radii) {
                 *x = (*dir * *r).length();
-                r_min = r_min.min(*x);
-                r_max = r_max.max(*x);
             }
             let mut col = m.column(*dir);
             // Refine while some sample may still need it. Refining further than a sample needs
@@ -745,6 +742,8 @@ impl Density for EarthDensity {
                     m.advance(&mut col, *dir);
                 }
             } else {
+                let r_min = rs.iter().copied().fold(f64::INFINITY, f64::min);
+                let r_max = rs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 while col.done < m.entries.len() && col.keep_lo[col.done] < r_max && r_min < col.keep_hi[col.done] {
                     m.advance(&mut col, *dir);
                 }
