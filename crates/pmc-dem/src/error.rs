@@ -212,6 +212,15 @@ pub enum DemError {
         /// The variable read.
         variable: String,
     },
+    /// A read asked for samples outside the grid, or gave a buffer of the wrong size: a bug in
+    /// the caller, reported instead of panicking.
+    #[error("{file}: {detail}")]
+    OutOfGrid {
+        /// The file.
+        file: String,
+        /// What was asked.
+        detail: String,
+    },
 }
 
 /// The names in `items`, separated by commas, or `no variables` when there are none.
@@ -238,6 +247,7 @@ impl DemError {
             | DemError::UnsuitableVariable { file, .. }
             | DemError::MissingAxis { file, .. }
             | DemError::AxisNotMonotonic { file, .. }
+            | DemError::OutOfGrid { file, .. }
             | DemError::AxisUneven { file, .. }
             | DemError::AxisInvalid { file, .. }
             | DemError::LatitudeOutOfRange { file, .. }

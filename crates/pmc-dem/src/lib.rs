@@ -40,8 +40,10 @@ mod dem;
 mod error;
 mod header;
 mod read;
+mod source;
 
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
 pub use header::MAX_HEADER_BYTES;
 pub use read::MAX_CELLS;
+pub use source::EquirectSource;
