@@ -36,12 +36,14 @@
 #![warn(missing_docs)]
 
 mod axis;
+pub mod cube;
 mod dem;
 mod error;
 mod header;
 mod read;
 mod source;
 
+pub use cube::{import_cube, CubeDem, DetailNoise, ImportOptions, ImportReport, Interpolation};
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
 pub use header::MAX_HEADER_BYTES;
