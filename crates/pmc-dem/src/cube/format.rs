@@ -75,7 +75,9 @@ impl SampleFormat {
     /// Decodes one stored sample (`bytes()` bytes, little-endian).
     pub(crate) fn decode(self, b: &[u8]) -> f32 {
         match self {
-            SampleFormat::I16 { scale, offset } => (offset + scale * f64::from(i16::from_le_bytes([b[0], b[1]]))) as f32,
+            SampleFormat::I16 { scale, offset } => {
+                (offset + scale * f64::from(i16::from_le_bytes([b[0], b[1]]))) as f32
+            }
             SampleFormat::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
         }
     }
@@ -306,7 +308,10 @@ impl Header {
             )));
         }
         if get_u32(b, 12) != HEADER_BYTES as u32 {
-            return Err(corrupt(format!("header length {} (v1 headers are 512 bytes)", get_u32(b, 12))));
+            return Err(corrupt(format!(
+                "header length {} (v1 headers are 512 bytes)",
+                get_u32(b, 12)
+            )));
         }
         let n = u32::from(b[16]);
         if !(1..=MAX_DATA_LEVEL).contains(&n) {
@@ -326,7 +331,11 @@ impl Header {
         let (scale, offset) = (get_f64(b, 24), get_f64(b, 32));
         let format = match b[18] {
             1 if scale.is_finite() && scale > 0.0 && offset.is_finite() => SampleFormat::I16 { scale, offset },
-            1 => return Err(corrupt(format!("16-bit samples with scale {scale} and offset {offset}"))),
+            1 => {
+                return Err(corrupt(format!(
+                    "16-bit samples with scale {scale} and offset {offset}"
+                )))
+            }
             2 => SampleFormat::F32,
             c => return Err(corrupt(format!("unknown sample format code {c}"))),
         };
@@ -341,7 +350,10 @@ impl Header {
         let grid = TileGrid::new(n, tile);
         let tiles = get_u64(b, 80);
         if tiles != grid.total {
-            return Err(corrupt(format!("{tiles} tiles listed where the levels hold {}", grid.total)));
+            return Err(corrupt(format!(
+                "{tiles} tiles listed where the levels hold {}",
+                grid.total
+            )));
         }
         let table_offset = get_u64(b, 88);
         let data_offset = get_u64(b, 96);
@@ -428,7 +440,14 @@ impl Entry {
     }
 
     /// Decodes entry `idx` and checks it against the tile's geometry and the data area.
-    pub fn decode(file: &str, b: &[u8], idx: u64, tile: &TileRef, format: SampleFormat, data: (u64, u64)) -> Result<Entry, DemError> {
+    pub fn decode(
+        file: &str,
+        b: &[u8],
+        idx: u64,
+        tile: &TileRef,
+        format: SampleFormat,
+        data: (u64, u64),
+    ) -> Result<Entry, DemError> {
         let offset = get_u64(b, 0);
         let len = get_u32(b, 8);
         let crc = get_u32(b, 12);
@@ -483,7 +502,10 @@ mod tests {
 
     #[test]
     fn i16_round_trip() {
-        let f = SampleFormat::I16 { scale: 1.0, offset: 0.0 };
+        let f = SampleFormat::I16 {
+            scale: 1.0,
+            offset: 0.0,
+        };
         assert_eq!(f.round_trip(12.4), 12.0);
         assert_eq!(f.round_trip(-40000.0), -32768.0);
         let mut v = Vec::new();

@@ -174,14 +174,20 @@ pub fn import_cube(
 ) -> Result<ImportReport, DemError> {
     let (w, h) = (source.width(), source.height());
     if w < 2 || h < 2 {
-        return Err(invalid(source, format!("a grid of {w} x {h} samples; at least 2 x 2 are needed")));
+        return Err(invalid(
+            source,
+            format!("a grid of {w} x {h} samples; at least 2 x 2 are needed"),
+        ));
     }
     for (what, v) in [
         ("longitude step", source.lon_step()),
         ("latitude step", source.lat_step()),
     ] {
         if !(v.is_finite() && v > 0.0) {
-            return Err(invalid(source, format!("the source's {what} is {v}; it must be above 0")));
+            return Err(invalid(
+                source,
+                format!("the source's {what} is {v}; it must be above 0"),
+            ));
         }
     }
     let n = options.level.unwrap_or_else(|| default_level(source));
@@ -192,13 +198,22 @@ pub fn import_cube(
         ));
     }
     if !(2..=4096).contains(&options.tile_size) {
-        return Err(invalid(source, format!("tile size {} asked for; 2 to 4096 are supported", options.tile_size)));
+        return Err(invalid(
+            source,
+            format!("tile size {} asked for; 2 to 4096 are supported", options.tile_size),
+        ));
     }
     if !(options.radius.is_finite() && options.radius > 0.0) {
-        return Err(invalid(source, format!("radius {} m; it must be a number of metres above 0", options.radius)));
+        return Err(invalid(
+            source,
+            format!("radius {} m; it must be a number of metres above 0", options.radius),
+        ));
     }
     if !options.datum.is_finite() || options.fill_value.is_some_and(|v| !v.is_finite()) {
-        return Err(invalid(source, "the datum and the fill value must be finite numbers".to_owned()));
+        return Err(invalid(
+            source,
+            "the datum and the fill value must be finite numbers".to_owned(),
+        ));
     }
     let row_bytes = w * 4;
     let max_rows = (options.memory_budget / 2 / row_bytes).min(h);
@@ -234,8 +249,14 @@ pub fn import_cube(
         .collect();
 
     // The output goes to a temporary file that is renamed into place on success.
-    let dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = out.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = out
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
     let tmp_path = dir.join(format!(".{name}.tmp-{}-{unique}", std::process::id()));
@@ -300,7 +321,11 @@ pub fn import_cube(
                 if r < first || r >= end {
                     return;
                 }
-                let v = if pos.inside { grid.bilinear(&pos, buf, first) } else { None };
+                let v = if pos.inside {
+                    grid.bilinear(&pos, buf, first)
+                } else {
+                    None
+                };
                 vals[k] = match v {
                     Some(v) => v as f32,
                     None => {

@@ -13,11 +13,12 @@ mod source_grid;
 
 pub use detail::{DetailNoise, DEFAULT_DETAIL_SEED, DEFAULT_RELIEF_SLOPE, DEFAULT_ROUGHNESS, MAX_DETAIL_OCTAVES};
 pub use format::{
-    stored_levels, SampleFormat, COARSEST_OVERVIEW_LOG2, DEFAULT_TILE_SIZE, HEADER_BYTES, MAGIC, MAX_DATA_LEVEL, VERSION,
+    stored_levels, SampleFormat, COARSEST_OVERVIEW_LOG2, DEFAULT_TILE_SIZE, HEADER_BYTES, MAGIC, MAX_DATA_LEVEL,
+    VERSION,
 };
 pub use import::{
-    centre_spacing_radians, default_level, import_cube, FormatChoice, ImportOptions, ImportReport, DEFAULT_MEMORY_BUDGET,
-    DEFAULT_RADIUS,
+    centre_spacing_radians, default_level, import_cube, FormatChoice, ImportOptions, ImportReport,
+    DEFAULT_MEMORY_BUDGET, DEFAULT_RADIUS,
 };
 pub use reader::{CubeDem, StorageRow, DEFAULT_CACHE_BYTES};
 pub use sample::{Interpolation, MAX_LATTICE_RESOLUTION};

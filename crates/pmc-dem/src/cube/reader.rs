@@ -257,10 +257,12 @@ impl CubeDem {
     fn read_tile_bytes(&self, idx: u64) -> Result<(Entry, Vec<u8>), DemError> {
         let e = self.entries[idx as usize];
         let mut bytes = vec![0u8; e.len as usize];
-        self.file.read_exact_at(&mut bytes, e.offset).map_err(|source| DemError::Io {
-            file: self.path.clone(),
-            source,
-        })?;
+        self.file
+            .read_exact_at(&mut bytes, e.offset)
+            .map_err(|source| DemError::Io {
+                file: self.path.clone(),
+                source,
+            })?;
         if crc32fast::hash(&bytes) != e.crc {
             let t = self.grid.tile(idx);
             return Err(DemError::CubeCorrupt {
@@ -316,7 +318,10 @@ impl CubeDem {
         if digest != self.header.digest {
             return Err(DemError::CubeCorrupt {
                 file: self.path.clone(),
-                detail: format!("the tiles' digest is {digest} but the header records {}", self.header.digest),
+                detail: format!(
+                    "the tiles' digest is {digest} but the header records {}",
+                    self.header.digest
+                ),
             });
         }
         Ok(())

@@ -39,7 +39,8 @@ impl CubeDem {
     /// The value of data sample `(i, j)` of `face` (level 0), `NaN` if its tile cannot be read.
     #[inline]
     fn data(&self, face: Face, i: i32, j: i32) -> f64 {
-        self.value(0, face.index(), i as u32, j as u32).map_or(f64::NAN, f64::from)
+        self.value(0, face.index(), i as u32, j as u32)
+            .map_or(f64::NAN, f64::from)
     }
 
     /// The data at face indices that may lie one step past an edge: unfolded onto the

@@ -197,11 +197,7 @@ impl CoarseFill {
             let mut next = [None; 4];
             next[0] = (r > 0).then(|| k - gw);
             next[1] = (r + 1 < gh).then(|| k + gw);
-            next[2] = if c > 0 {
-                Some(k - 1)
-            } else {
-                wraps.then(|| k + gw - 1)
-            };
+            next[2] = if c > 0 { Some(k - 1) } else { wraps.then(|| k + gw - 1) };
             next[3] = if c + 1 < gw {
                 Some(k + 1)
             } else {
