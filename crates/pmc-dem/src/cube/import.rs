@@ -299,71 +299,78 @@ pub fn import_cube(
         source.read_rows(first, rows, buf)?;
         let buf = &band[..rows * w];
         let last_band = b + 1 == bands;
-        let mut work: Vec<(u64, Vec<f32>)> = (0..tiles.total)
+        let candidates: Vec<u64> = (0..tiles.total)
             .filter(|&idx| {
                 let (lo, hi) = ranges[idx as usize];
                 (lo as usize) < end && hi as usize >= first
             })
-            .map(|idx| {
-                let t = tiles.tile(idx);
-                let v = open
-                    .remove(&idx)
-                    .unwrap_or_else(|| vec![f32::NAN; t.w as usize * t.h as usize]);
-                (idx, v)
-            })
             .collect();
-        work.par_iter_mut().for_each(|(idx, vals)| {
-            let t = tiles.tile(*idx);
-            let mut local_filled = 0;
-            for_each_sample(&t, big_n, |k, p| {
-                let pos = position(&grid, p);
-                let r = key_row(&grid, &pos);
-                if r < first || r >= end {
-                    return;
-                }
-                let v = if pos.inside {
-                    grid.bilinear(&pos, buf, first)
-                } else {
-                    None
-                };
-                vals[k] = match v {
-                    Some(v) => v as f32,
-                    None => {
-                        local_filled += 1;
-                        options.fill_value.unwrap_or_else(|| survey.fill.value(&pos))
+        // A few tiles per thread at a time: bounded buffers, steady progress.
+        let chunk = (rayon::current_num_threads() * 16).max(64);
+        for ids in candidates.chunks(chunk) {
+            let mut work: Vec<(u64, Vec<f32>)> = ids
+                .iter()
+                .map(|&idx| {
+                    let t = tiles.tile(idx);
+                    let v = open
+                        .remove(&idx)
+                        .unwrap_or_else(|| vec![f32::NAN; t.w as usize * t.h as usize]);
+                    (idx, v)
+                })
+                .collect();
+            work.par_iter_mut().for_each(|(idx, vals)| {
+                let t = tiles.tile(*idx);
+                let mut local_filled = 0;
+                for_each_sample(&t, big_n, |k, p| {
+                    let pos = position(&grid, p);
+                    let r = key_row(&grid, &pos);
+                    if r < first || r >= end {
+                        return;
                     }
-                };
+                    let v = if pos.inside {
+                        grid.bilinear(&pos, buf, first)
+                    } else {
+                        None
+                    };
+                    vals[k] = match v {
+                        Some(v) => v as f32,
+                        None => {
+                            local_filled += 1;
+                            options.fill_value.unwrap_or_else(|| survey.fill.value(&pos))
+                        }
+                    };
+                });
+                if t.level == 0 {
+                    filled.fetch_add(local_filled, Ordering::Relaxed);
+                }
             });
-            if t.level == 0 {
-                filled.fetch_add(local_filled, Ordering::Relaxed);
+            let (finished, still_open): (Vec<_>, Vec<_>) = work
+                .into_iter()
+                .partition(|(idx, _)| last_band || (ranges[*idx as usize].1 as usize) < end);
+            open.extend(still_open);
+            let encoded: Vec<(u64, TileKind, Vec<u8>, [u8; 32])> = finished
+                .into_par_iter()
+                .map(|(idx, vals)| {
+                    let (kind, bytes) = encode_tile(format, &vals);
+                    let hash = tile_hash(kind, &bytes);
+                    (idx, kind, bytes, hash)
+                })
+                .collect();
+            for (idx, kind, bytes, hash) in encoded {
+                file.write_all_at(&bytes, write_at).map_err(werr)?;
+                entries[idx as usize] = Entry {
+                    offset: write_at,
+                    len: bytes.len() as u32,
+                    crc: crc32fast::hash(&bytes),
+                    kind,
+                };
+                hashes[idx as usize] = hash;
+                constant_tiles += u64::from(kind == TileKind::Constant);
+                write_at += bytes.len() as u64;
+                done += 1;
             }
-        });
-        let (finished, still_open): (Vec<_>, Vec<_>) = work
-            .into_iter()
-            .partition(|(idx, _)| last_band || (ranges[*idx as usize].1 as usize) < end);
-        open.extend(still_open);
-        let encoded: Vec<(u64, TileKind, Vec<u8>, [u8; 32])> = finished
-            .into_par_iter()
-            .map(|(idx, vals)| {
-                let (kind, bytes) = encode_tile(format, &vals);
-                let hash = tile_hash(kind, &bytes);
-                (idx, kind, bytes, hash)
-            })
-            .collect();
-        for (idx, kind, bytes, hash) in encoded {
-            file.write_all_at(&bytes, write_at).map_err(werr)?;
-            entries[idx as usize] = Entry {
-                offset: write_at,
-                len: bytes.len() as u32,
-                crc: crc32fast::hash(&bytes),
-                kind,
-            };
-            hashes[idx as usize] = hash;
-            constant_tiles += u64::from(kind == TileKind::Constant);
-            write_at += bytes.len() as u64;
-            done += 1;
+            progress(done, tiles.total);
         }
-        progress(done, tiles.total);
     }
     debug_assert!(open.is_empty());
 

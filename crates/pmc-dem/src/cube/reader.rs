@@ -30,6 +30,7 @@ pub struct CubeDem {
     entries: Vec<Entry>,
     shards: Vec<Mutex<Shard>>,
     shard_budget: usize,
+    spacing: f64,
 }
 
 #[derive(Debug, Default)]
@@ -102,7 +103,9 @@ impl CubeDem {
                 Entry::decode(&name, b, k as u64, &t, header.format, (header.data_offset, len))
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let spacing = centre_spacing_radians(header.n) * header.radius;
         Ok(CubeDem {
+            spacing,
             path: name,
             file,
             header,
@@ -169,7 +172,7 @@ impl CubeDem {
 
     /// Metres between data samples at a face centre (the spacing of detail octave 0).
     pub fn data_spacing(&self) -> f64 {
-        centre_spacing_radians(self.header.n) * self.header.radius
+        self.spacing
     }
 
     /// Bounds of every height [`CubeDem::height`] can return with the default
