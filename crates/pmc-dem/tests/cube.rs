@@ -739,6 +739,11 @@ fn a_failed_import_leaves_nothing() {
             tile_size: 1,
             ..Default::default()
         },
+        ImportOptions {
+            level: Some(16),
+            tile_size: 2,
+            ..Default::default()
+        },
     ] {
         let e = import_cube(fixture(), &out, &opts, &|_, _| {}).unwrap_err();
         assert!(matches!(e, DemError::InvalidOptions { .. }), "{e}");

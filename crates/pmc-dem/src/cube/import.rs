@@ -22,6 +22,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The default memory budget of an import: 512 MiB.
 pub const DEFAULT_MEMORY_BUDGET: usize = 512 << 20;
+/// The most tiles an import writes (the tile table and the per-tile bookkeeping stay below about
+/// 4 GiB): larger levels need larger tiles.
+pub const MAX_TILES: u64 = 1 << 26;
 /// The default body radius: the Earth's mean radius, 6 371 000 m.
 pub const DEFAULT_RADIUS: f64 = 6_371_000.0;
 
@@ -232,6 +235,15 @@ pub fn import_cube(
     let format = choose_format(options, &survey);
 
     let tiles = TileGrid::new(n, options.tile_size);
+    if tiles.total > MAX_TILES {
+        return Err(invalid(
+            source,
+            format!(
+                "level {n} in tiles of {} samples makes {} tiles, more than the {MAX_TILES} supported; use larger tiles",
+                options.tile_size, tiles.total
+            ),
+        ));
+    }
     let big_n = 1i32 << n;
     // The source rows each tile needs: the range of the lower interpolation rows of its samples.
     let ranges: Vec<(u32, u32)> = (0..tiles.total)

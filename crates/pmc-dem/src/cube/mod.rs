@@ -18,7 +18,7 @@ pub use format::{
 };
 pub use import::{
     centre_spacing_radians, default_level, import_cube, FormatChoice, ImportOptions, ImportReport,
-    DEFAULT_MEMORY_BUDGET, DEFAULT_RADIUS,
+    DEFAULT_MEMORY_BUDGET, DEFAULT_RADIUS, MAX_TILES,
 };
 pub use reader::{CubeDem, StorageRow, DEFAULT_CACHE_BYTES};
 pub use sample::{Interpolation, MAX_LATTICE_RESOLUTION};
