@@ -212,6 +212,65 @@ pub enum DemError {
         /// The variable read.
         variable: String,
     },
+    /// The file is not a `.pmcdem` cube-face elevation file: it does not start with the
+    /// `.pmcdem` signature (it is empty, a netCDF grid, an image, or something else). Fix: check
+    /// the path; make `.pmcdem` files from an equirectangular grid with
+    /// [`import_cube`](crate::import_cube).
+    #[error("{file}: not a .pmcdem cube elevation file: {detail}")]
+    NotCubeDem {
+        /// The file.
+        file: String,
+        /// What was found instead.
+        detail: String,
+    },
+    /// The `.pmcdem` file has a format version this reader does not know (a newer writer, or a
+    /// damaged header). Fix: read it with a newer version of this crate, or import the source
+    /// again.
+    #[error("{file}: .pmcdem version {version} is not supported (this reader knows version 1); use a newer reader or import the source again")]
+    UnsupportedVersion {
+        /// The file.
+        file: String,
+        /// The version found in the header.
+        version: u32,
+    },
+    /// A `.pmcdem` file is damaged: a checksum (header, tile table or tile) does not match its
+    /// bytes, or a header field or table entry contradicts the others or the file's length. Fix:
+    /// copy the file again or import its source again.
+    #[error("{file}: the .pmcdem file is damaged: {detail}; copy it again or import its source again")]
+    CubeCorrupt {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// The output file (or its temporary file next to it) could not be created, written, or
+    /// renamed into place; nothing is left at the output path. Fix: check the directory exists,
+    /// is writable and has room.
+    #[error("{file}: cannot write the file: {source}; check that the directory exists, is writable and has room")]
+    Write {
+        /// The file.
+        file: String,
+        /// The system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Import options that cannot work (a level above the maximum, a memory budget too small
+    /// for two rows of the source, a radius that is not a positive number); refused before
+    /// anything is written. Fix: change the option named in the message.
+    #[error("{file}: {detail}")]
+    InvalidOptions {
+        /// The source file the import was for.
+        file: String,
+        /// Which option is wrong and what is accepted.
+        detail: String,
+    },
+    /// The source to import holds no valid sample (every value missing). Fix: check the source
+    /// grid and the variable read.
+    #[error("{file}: the grid holds no valid sample to import: every value is missing")]
+    EmptySource {
+        /// The file.
+        file: String,
+    },
     /// A read asked for samples outside the grid, or gave a buffer of the wrong size: a bug in
     /// the caller, reported instead of panicking.
     #[error("{file}: {detail}")]
@@ -252,7 +311,13 @@ impl DemError {
             | DemError::AxisInvalid { file, .. }
             | DemError::LatitudeOutOfRange { file, .. }
             | DemError::TooLarge { file, .. }
-            | DemError::NoValidData { file, .. } => file,
+            | DemError::NoValidData { file, .. }
+            | DemError::NotCubeDem { file, .. }
+            | DemError::UnsupportedVersion { file, .. }
+            | DemError::CubeCorrupt { file, .. }
+            | DemError::Write { file, .. }
+            | DemError::InvalidOptions { file, .. }
+            | DemError::EmptySource { file } => file,
         }
     }
 }

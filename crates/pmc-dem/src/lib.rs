@@ -1,6 +1,6 @@
-//! Digital elevation models on equirectangular grids, read from netCDF classic files: heights in
+//! Digital elevation models: equirectangular grids read from netCDF classic files (heights in
 //! metres at evenly spaced longitudes and latitudes, with bilinear sampling that wraps round the
-//! globe.
+//! globe), and cube-face `.pmcdem` files made from them (see "Cube-face files" below).
 //!
 //! [`EquirectDem::read_netcdf`] reads a netCDF classic (CDF-1) or 64-bit offset (CDF-2) file such
 //! as NOAA's ETOPO relief grids. The file's coordinate variables give the axes; the result is
@@ -30,18 +30,60 @@
 //! # Ok::<(), pmc_dem::DemError>(())
 //! ```
 //!
+//! # Cube-face files
+//!
+//! [`import_cube`] reprojects any [`EquirectSource`] once onto the six faces of the cube-sphere
+//! and writes a `.pmcdem` file (spec: `docs/specs/pmcdem-v1.md`): `2^n + 1` samples a face
+//! side with bit-identical shared edges, decimated overviews down to 65 samples, checksummed
+//! tiles, read in bands of rows within a memory budget. [`CubeDem`] reads it tile by tile
+//! (a bounded cache, `Send + Sync`) and gives heights anywhere: interpolated data, exact at the
+//! data samples, plus [`DetailNoise`] octaves below the data resolution that are exactly zero at
+//! the samples (seed 003 Sec. 4.5, 4.6).
+//!
+//! ```
+//! use pmc_dem::cube::{import_cube, CubeDem, DetailNoise, ImportOptions, Interpolation};
+//! use pmc_dem::EquirectDem;
+//! use pmc_geometry::{glam::IVec3, LatLon};
+//!
+//! let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/etopo60.cdf");
+//! let dem = EquirectDem::read_netcdf(&src, None)?;
+//! let out = std::env::temp_dir().join(format!("pmc-dem-doc-{}.pmcdem", std::process::id()));
+//! let options = ImportOptions { level: Some(6), ..Default::default() }; // 65 samples a side
+//! let report = import_cube(&dem, &out, &options, &|_done, _total| {})?;
+//! assert_eq!(report.level, 6);
+//!
+//! let cube = CubeDem::open(&out)?;
+//! cube.verify()?; // every tile's checksum and the content digest
+//! let detail = DetailNoise::default();
+//! // Any direction, with detail octaves down to 10 m.
+//! let everest = LatLon::new(28.0, 87.0).unwrap().to_unit();
+//! let h = cube.height(everest, Interpolation::Bicubic, &detail, 10.0);
+//! assert!(h > 2000.0, "{h}");
+//! // A data sample (the centre of the South face, resolution 64) is returned exactly.
+//! let centre = IVec3::new(0, 0, 64);
+//! let stored = cube.sample(0, pmc_geometry::Face::South, 32, 32)?;
+//! assert_eq!(cube.height_at_lattice(centre, 64, Interpolation::Bilinear, &detail), f64::from(stored));
+//! # std::fs::remove_file(&out).unwrap();
+//! # Ok::<(), pmc_dem::DemError>(())
+//! ```
+//!
+//! The example `dem_import` times an import by hand:
+//! `cargo run --release -p pmc-dem --example dem_import -- IN.cdf OUT.pmcdem [LEVEL] [BUDGET_MIB]`.
+//!
 //! The example `dem_info` prints what is read from a file:
 //! `cargo run --release -p pmc-dem --example dem_info -- FILE.cdf [VARIABLE]`.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod axis;
+pub mod cube;
 mod dem;
 mod error;
 mod header;
 mod read;
 mod source;
 
+pub use cube::{import_cube, CubeDem, DetailNoise, ImportOptions, ImportReport, Interpolation};
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
 pub use header::MAX_HEADER_BYTES;

@@ -1,0 +1,100 @@
+//! Detail noise below the data resolution (seed 003 Sec. 4.6): octaves of gradient noise whose
+//! lattices line up with the cube lattice, so that every octave is exactly zero at every data
+//! sample.
+
+use pmc_density::noise::{derive_seed, gradient3};
+use pmc_geometry::glam::DVec3;
+
+/// Default noise seed of [`DetailNoise`].
+pub const DEFAULT_DETAIL_SEED: u64 = 0x003d_e7a1_1000_0003;
+/// Default roughness: octave `k` has amplitude `0.05 x` its lattice spacing in metres (slopes of
+/// a few per cent, a gently rough surface).
+pub const DEFAULT_ROUGHNESS: f64 = 0.05;
+/// Default relief slope: where the data rise or fall by at least 2 % of the data spacing between
+/// neighbouring samples, the detail has its full amplitude; flatter data (a sea floor, a plain)
+/// get proportionally less, perfectly flat data none.
+pub const DEFAULT_RELIEF_SLOPE: f64 = 0.02;
+/// The most detail octaves evaluated (octave 30 has a spacing a billionth of the data's).
+pub const MAX_DETAIL_OCTAVES: u32 = 30;
+
+/// Procedural detail added between the data samples.
+///
+/// Octave `k` (from 0) is gradient noise on a lattice of spacing `data spacing / 2^k`, aligned
+/// with the cube lattice of resolution `2^(n+k)`: it is evaluated at the cube-surface point
+/// `c` (in `[-1, 1]^3`) scaled to `c 2^(n-1+k)`, so its lattice points are the cube lattice
+/// points of resolution `2^(n+k)` and coarser, where it is exactly zero: the data samples stay
+/// exact, and a lattice point of resolution `2^(n+j)` gets only octaves `0 .. j`.
+///
+/// Octave `k` has amplitude `roughness x data spacing / 2^k` (metres; the data spacing at a face
+/// centre), times a relief weight in `[0, 1]`: at each data sample the largest height
+/// difference to its four neighbours divided by `relief_slope x data spacing` (capped at 1),
+/// interpolated bilinearly between the samples, so flat areas stay smooth. `relief_slope <= 0`
+/// turns the weighting off (weight 1 everywhere).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DetailNoise {
+    /// Noise seed; octave `k` uses `derive_seed(seed, k)`.
+    pub seed: u64,
+    /// Amplitude of each octave as a fraction of its lattice spacing; 0 turns the detail off.
+    pub roughness: f64,
+    /// Slope of the data at and above which the detail has its full amplitude; 0 or less: no
+    /// relief weighting.
+    pub relief_slope: f64,
+}
+
+impl Default for DetailNoise {
+    fn default() -> Self {
+        DetailNoise {
+            seed: DEFAULT_DETAIL_SEED,
+            roughness: DEFAULT_ROUGHNESS,
+            relief_slope: DEFAULT_RELIEF_SLOPE,
+        }
+    }
+}
+
+impl DetailNoise {
+    /// No detail: heights are the interpolated data.
+    pub const OFF: DetailNoise = DetailNoise {
+        seed: DEFAULT_DETAIL_SEED,
+        roughness: 0.0,
+        relief_slope: 0.0,
+    };
+
+    /// Whether any detail is added.
+    pub fn is_on(&self) -> bool {
+        self.roughness != 0.0 && self.roughness.is_finite()
+    }
+
+    /// The most the detail can add or remove, in metres, for data spacing `spacing` metres:
+    /// `|roughness| x spacing x (1 + 1/2 + 1/4 + ...) = 2 |roughness| spacing` (each octave lies
+    /// in `[-1, 1]` times its amplitude, the weight in `[0, 1]`).
+    pub fn bound(&self, spacing: f64) -> f64 {
+        if self.is_on() {
+            2.0 * self.roughness.abs() * spacing
+        } else {
+            0.0
+        }
+    }
+
+    /// The relief weight of a data sample whose largest height difference to its neighbours is
+    /// `relief` metres, for data spacing `spacing` metres.
+    pub fn relief_weight(&self, relief: f64, spacing: f64) -> f64 {
+        if self.relief_slope <= 0.0 || self.relief_slope.is_nan() {
+            return 1.0;
+        }
+        (relief / (self.relief_slope * spacing)).clamp(0.0, 1.0)
+    }
+
+    /// The sum of octaves `0 .. octaves` at octave-0 noise coordinates `p` (the cube point times
+    /// `2^(n-1)`), unweighted, for data spacing `spacing` metres.
+    pub(crate) fn sum(&self, p: DVec3, octaves: u32, spacing: f64) -> f64 {
+        let mut total = 0.0;
+        let mut scale = 1.0;
+        let mut amp = self.roughness * spacing;
+        for k in 0..octaves.min(MAX_DETAIL_OCTAVES) {
+            total += amp * gradient3(p * scale, derive_seed(self.seed, u64::from(k)));
+            scale *= 2.0;
+            amp *= 0.5;
+        }
+        total
+    }
+}

@@ -1,0 +1,332 @@
+//! Reading `.pmcdem` files tile by tile, with checksums and a bounded cache of decoded tiles.
+
+use super::detail::DetailNoise;
+use super::format::{Entry, Header, SampleFormat, TileGrid, TileKind, ENTRY_BYTES, HEADER_BYTES};
+use super::import::{centre_spacing_radians, content_digest, tile_hash};
+use crate::error::DemError;
+use pmc_geometry::Face;
+use std::collections::{HashMap, VecDeque};
+use std::fs::File;
+use std::os::unix::fs::FileExt;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+/// Bytes of decoded tiles a [`CubeDem`] keeps by default: 256 MiB.
+pub const DEFAULT_CACHE_BYTES: usize = 256 << 20;
+/// Lock shards of the tile cache (tiles are spread over them by index).
+const SHARDS: usize = 16;
+
+/// A cube-face elevation model read from a `.pmcdem` file (`docs/specs/pmcdem-v1.md`).
+///
+/// [`CubeDem::open`] reads and checks the header and the tile table only; tiles are read when
+/// first needed, with positioned reads, their checksums checked, and kept decoded in a cache of
+/// bounded size (first in, first out). `Send + Sync`: one `CubeDem` serves many threads.
+#[derive(Debug)]
+pub struct CubeDem {
+    pub(crate) path: String,
+    file: File,
+    pub(crate) header: Header,
+    pub(crate) grid: TileGrid,
+    entries: Vec<Entry>,
+    shards: Vec<Mutex<Shard>>,
+    shard_budget: usize,
+    spacing: f64,
+}
+
+#[derive(Debug, Default)]
+struct Shard {
+    map: HashMap<u64, Arc<Vec<f32>>>,
+    order: VecDeque<u64>,
+    bytes: usize,
+}
+
+/// One row of [`CubeDem::storage_table`]: a level of the file or a finer level made by the
+/// detail noise alone (seed 003 Fig. 13).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StorageRow {
+    /// Resolution exponent: `2^log2 + 1` samples a face side.
+    pub log2: u32,
+    /// Samples along a face side.
+    pub samples_per_side: u64,
+    /// Bytes of six faces of this many samples at 16 bits a sample (as the paper's table).
+    pub bytes_16bit: u64,
+    /// Bytes this level takes in the file (tiles only); `None` for levels finer than the data.
+    pub bytes_stored: Option<u64>,
+    /// Metres between neighbouring samples at a face centre.
+    pub metres_at_centre: f64,
+    /// Metres between samples along the equator on average: `2 pi R / (4 (samples - 1))`.
+    pub metres_at_equator: f64,
+    /// Whether the level is stored (data or overview) rather than made by the detail noise.
+    pub stored: bool,
+}
+
+impl CubeDem {
+    /// Opens a `.pmcdem` file with a tile cache of [`DEFAULT_CACHE_BYTES`].
+    pub fn open(path: impl AsRef<Path>) -> Result<CubeDem, DemError> {
+        CubeDem::open_with_cache(path, DEFAULT_CACHE_BYTES)
+    }
+
+    /// Opens a `.pmcdem` file keeping at most about `cache_bytes` of decoded tiles (at least one
+    /// tile per lock shard is kept whatever the budget).
+    ///
+    /// Checks the signature, the version, the header checksum, every header field against the
+    /// others and against the file's length, then reads the tile table (whose size is then known
+    /// to fit in the file), its checksum and every entry against the tile geometry. Errors name
+    /// the file; nothing is allocated from an unchecked size.
+    pub fn open_with_cache(path: impl AsRef<Path>, cache_bytes: usize) -> Result<CubeDem, DemError> {
+        let name = path.as_ref().display().to_string();
+        let io = |source: std::io::Error| DemError::Io {
+            file: name.clone(),
+            source,
+        };
+        let file = File::open(path.as_ref()).map_err(io)?;
+        let len = file.metadata().map_err(io)?.len();
+        let mut head = vec![0u8; (HEADER_BYTES as u64).min(len) as usize];
+        file.read_exact_at(&mut head, 0).map_err(io)?;
+        let header = Header::decode(&name, &head, len)?;
+        let grid = TileGrid::new(header.n, header.tile);
+        let mut table = vec![0u8; (header.data_offset - header.table_offset) as usize];
+        file.read_exact_at(&mut table, header.table_offset).map_err(io)?;
+        let (body, crc) = table.split_at(table.len() - 4);
+        let stored = u32::from_le_bytes(crc.try_into().expect("4 bytes"));
+        if crc32fast::hash(body) != stored {
+            return Err(DemError::CubeCorrupt {
+                file: name,
+                detail: "the tile table's checksum does not match its bytes".to_owned(),
+            });
+        }
+        let entries = body
+            .chunks_exact(ENTRY_BYTES)
+            .enumerate()
+            .map(|(k, b)| {
+                let t = grid.tile(k as u64);
+                Entry::decode(&name, b, k as u64, &t, header.format, (header.data_offset, len))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let spacing = centre_spacing_radians(header.n) * header.radius;
+        Ok(CubeDem {
+            spacing,
+            path: name,
+            file,
+            header,
+            grid,
+            entries,
+            shards: (0..SHARDS).map(|_| Mutex::new(Shard::default())).collect(),
+            shard_budget: cache_bytes / SHARDS,
+        })
+    }
+
+    /// The path the file was opened from.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+    /// The data level `n`: faces of `2^n + 1` samples a side.
+    pub fn data_level(&self) -> u32 {
+        self.header.n
+    }
+    /// Levels stored: the data level (index 0) and its overviews (index `k`: `2^(n-k) + 1`
+    /// samples a side, down to 65).
+    pub fn levels(&self) -> u32 {
+        self.header.levels
+    }
+    /// Samples along a face side at level index `k` (0 for a level not stored).
+    pub fn samples_per_side(&self, k: u32) -> u32 {
+        self.grid.levels.get(k as usize).map_or(0, |l| l.side)
+    }
+    /// The body radius in metres.
+    pub fn radius(&self) -> f64 {
+        self.header.radius
+    }
+    /// The height of the datum (sea level) in the data's metres.
+    pub fn datum(&self) -> f64 {
+        self.header.datum
+    }
+    /// The content digest: SHA-256 (64 hex digits) of the tiles, see the spec.
+    pub fn digest(&self) -> &str {
+        &self.header.digest
+    }
+    /// The name of the source the file was imported from.
+    pub fn source_name(&self) -> &str {
+        &self.header.source_name
+    }
+    /// West, east, south, north bounds (degrees) of the source's samples.
+    pub fn source_extent(&self) -> [f64; 4] {
+        self.header.extent
+    }
+    /// The sample format.
+    pub fn format(&self) -> SampleFormat {
+        self.header.format
+    }
+    /// Samples a side of a tile.
+    pub fn tile_size(&self) -> u32 {
+        self.header.tile
+    }
+    /// Samples of the finest level that were missing in the source and filled.
+    pub fn filled_samples(&self) -> u64 {
+        self.header.filled
+    }
+    /// The smallest and largest stored value, metres.
+    pub fn value_range(&self) -> (f64, f64) {
+        (self.header.min, self.header.max)
+    }
+
+    /// Metres between data samples at a face centre (the spacing of detail octave 0).
+    pub fn data_spacing(&self) -> f64 {
+        self.spacing
+    }
+
+    /// Bounds of every height [`CubeDem::height`] can return with the default
+    /// [`DetailNoise`]: the data range widened by the bicubic overshoot and the noise bound.
+    pub fn height_bounds(&self) -> (f64, f64) {
+        self.height_bounds_with(&DetailNoise::default())
+    }
+
+    /// Bounds of every height [`CubeDem::height`] can return with `detail`: the data range,
+    /// widened by the most that bicubic interpolation can overshoot it (`0.28125` of the range:
+    /// Catmull-Rom weights sum to one with absolute values summing to at most `1.25^2`) and by
+    /// [`DetailNoise::bound`].
+    pub fn height_bounds_with(&self, detail: &DetailNoise) -> (f64, f64) {
+        let (min, max) = (self.header.min, self.header.max);
+        let widen = 0.28125 * (max - min) + detail.bound(self.data_spacing());
+        (min - widen, max + widen)
+    }
+
+    /// Storage and resolution per level, like seed 003 Fig. 13: the stored levels from the
+    /// coarsest overview to the data level, then the levels the detail noise adds below the data
+    /// resolution down to about one metre at a face centre.
+    pub fn storage_table(&self) -> Vec<StorageRow> {
+        let r = self.header.radius;
+        let mut stored_bytes = vec![0u64; self.grid.levels.len()];
+        for (k, e) in self.entries.iter().enumerate() {
+            let level = self.grid.tile(k as u64).level as usize;
+            stored_bytes[level] += u64::from(e.len) + ENTRY_BYTES as u64;
+        }
+        let n = self.header.n;
+        let first = n + 1 - self.header.levels;
+        let mut rows = Vec::new();
+        let mut log2 = first;
+        loop {
+            let side = (1u64 << log2) + 1;
+            let centre = centre_spacing_radians(log2) * r;
+            let stored = log2 <= n;
+            rows.push(StorageRow {
+                log2,
+                samples_per_side: side,
+                bytes_16bit: 6 * side * side * 2,
+                bytes_stored: stored.then(|| stored_bytes[(n - log2) as usize]),
+                metres_at_centre: centre,
+                metres_at_equator: std::f64::consts::TAU * r / (4.0 * (side - 1) as f64),
+                stored,
+            });
+            if (!stored && centre <= 1.0) || log2 >= 40 {
+                break;
+            }
+            log2 += 1;
+        }
+        rows
+    }
+
+    /// The stored value of sample `(i, j)` of `face` at level index `level` (0 = data level).
+    /// Errors: indices outside the level ([`DemError::OutOfGrid`]), or a tile that cannot be
+    /// read or fails its checksum.
+    pub fn sample(&self, level: u32, face: Face, i: u32, j: u32) -> Result<f32, DemError> {
+        let side = self.samples_per_side(level);
+        if i >= side || j >= side {
+            return Err(DemError::OutOfGrid {
+                file: self.path.clone(),
+                detail: format!(
+                    "sample ({i}, {j}) of level {level} asked for; it has {} levels of which this one has {side} samples a side",
+                    self.header.levels
+                ),
+            });
+        }
+        self.value(level, face.index(), i, j)
+    }
+
+    /// The value of an in-range sample.
+    #[inline]
+    pub(crate) fn value(&self, level: u32, face: usize, i: u32, j: u32) -> Result<f32, DemError> {
+        let idx = self.grid.index_of(level, face, i, j);
+        let tile = self.tile(idx)?;
+        if tile.len() == 1 {
+            return Ok(tile[0]);
+        }
+        let t = self.header.tile;
+        let w = self.grid.levels[level as usize].side.min((i / t) * t + t) - (i / t) * t;
+        Ok(tile[((j % t) * w + (i % t)) as usize])
+    }
+
+    /// Reads and checks the stored bytes of tile `idx`.
+    fn read_tile_bytes(&self, idx: u64) -> Result<(Entry, Vec<u8>), DemError> {
+        let e = self.entries[idx as usize];
+        let mut bytes = vec![0u8; e.len as usize];
+        self.file
+            .read_exact_at(&mut bytes, e.offset)
+            .map_err(|source| DemError::Io {
+                file: self.path.clone(),
+                source,
+            })?;
+        if crc32fast::hash(&bytes) != e.crc {
+            let t = self.grid.tile(idx);
+            return Err(DemError::CubeCorrupt {
+                file: self.path.clone(),
+                detail: format!(
+                    "tile {idx} (level {}, face {}, tile column {}, row {}) fails its checksum",
+                    t.level,
+                    Face::ALL[t.face],
+                    t.ti,
+                    t.tj
+                ),
+            });
+        }
+        Ok((e, bytes))
+    }
+
+    /// The decoded tile `idx`, from the cache or the file.
+    fn tile(&self, idx: u64) -> Result<Arc<Vec<f32>>, DemError> {
+        let shard = &self.shards[(idx % SHARDS as u64) as usize];
+        if let Some(t) = shard.lock().unwrap_or_else(|p| p.into_inner()).map.get(&idx) {
+            return Ok(Arc::clone(t));
+        }
+        let (e, bytes) = self.read_tile_bytes(idx)?;
+        let f = self.header.format;
+        let vals: Vec<f32> = match e.kind {
+            TileKind::Constant => vec![f.decode(&bytes)],
+            TileKind::Raw => bytes.chunks_exact(f.bytes()).map(|c| f.decode(c)).collect(),
+        };
+        let tile = Arc::new(vals);
+        let mut s = shard.lock().unwrap_or_else(|p| p.into_inner());
+        if s.map.insert(idx, Arc::clone(&tile)).is_none() {
+            s.order.push_back(idx);
+            s.bytes += tile.len() * 4;
+        }
+        while s.bytes > self.shard_budget && s.order.len() > 1 {
+            let old = s.order.pop_front().expect("non-empty");
+            if let Some(t) = s.map.remove(&old) {
+                s.bytes -= t.len() * 4;
+            }
+        }
+        Ok(tile)
+    }
+
+    /// Reads every tile, checks its checksum and recomputes the content digest, which must equal
+    /// the header's. Streams the file tile by tile (the cache is not used).
+    pub fn verify(&self) -> Result<(), DemError> {
+        let mut hashes = Vec::with_capacity(self.entries.len());
+        for idx in 0..self.grid.total {
+            let (e, bytes) = self.read_tile_bytes(idx)?;
+            hashes.push(tile_hash(e.kind, &bytes));
+        }
+        let digest = content_digest(self.header.n, self.header.format, &hashes);
+        if digest != self.header.digest {
+            return Err(DemError::CubeCorrupt {
+                file: self.path.clone(),
+                detail: format!(
+                    "the tiles' digest is {digest} but the header records {}",
+                    self.header.digest
+                ),
+            });
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,221 @@
+//! Heights anywhere on the sphere: interpolated data plus detail noise, exact at data samples.
+
+use super::detail::{DetailNoise, MAX_DETAIL_OCTAVES};
+use super::lattice::{home_face, indices_on, unfold};
+use super::reader::CubeDem;
+use pmc_geometry::glam::{DVec3, IVec3};
+use pmc_geometry::{face_uv_to_cube, sphere_to_face_uv, Face};
+
+/// How heights between data samples are interpolated. Both pass exactly through the samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Interpolation {
+    /// Bilinear in the face's sample indices (continuous, creased along sample rows).
+    #[default]
+    Bilinear,
+    /// Catmull-Rom bicubic in the face's sample indices (continuous first derivative within a
+    /// face). Samples past a face edge come from the neighbouring face, unfolded about the
+    /// edge; along the two edges through a cube corner the samples past the corner are the
+    /// corner's (clamped), so both faces of an edge interpolate it from the same samples.
+    Bicubic,
+}
+
+/// The largest lattice resolution [`CubeDem::height_at_lattice`] accepts: `2^30`.
+pub const MAX_LATTICE_RESOLUTION: i32 = 1 << 30;
+
+/// Catmull-Rom weights at `t` in `[0, 1]`: exactly `(0, 1, 0, 0)` at 0 and `(0, 0, 1, 0)` at 1.
+#[inline]
+fn catmull_rom(t: f64) -> [f64; 4] {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    [
+        -0.5 * t3 + t2 - 0.5 * t,
+        1.5 * t3 - 2.5 * t2 + 1.0,
+        -1.5 * t3 + 2.0 * t2 + 0.5 * t,
+        0.5 * t3 - 0.5 * t2,
+    ]
+}
+
+impl CubeDem {
+    /// The value of data sample `(i, j)` of `face` (level 0), `NaN` if its tile cannot be read.
+    #[inline]
+    fn data(&self, face: Face, i: i32, j: i32) -> f64 {
+        self.value(0, face.index(), i as u32, j as u32)
+            .map_or(f64::NAN, f64::from)
+    }
+
+    /// The data at face indices that may lie one step past an edge: unfolded onto the
+    /// neighbouring face, or clamped onto the corner along the edges through a cube corner.
+    fn stencil(&self, face: Face, i: i32, j: i32) -> f64 {
+        let r = 1i32 << self.header.n;
+        let in_i = (0..=r).contains(&i);
+        let in_j = (0..=r).contains(&j);
+        if in_i && in_j {
+            return self.data(face, i, j);
+        }
+        let inner = |x: i32| 0 < x && x < r;
+        if (in_i && inner(i)) || (in_j && inner(j)) {
+            if let Some(p) = unfold(face, r, i, j) {
+                return self.data_at_lattice(p, r);
+            }
+        }
+        self.data(face, i.clamp(0, r), j.clamp(0, r))
+    }
+
+    /// The data at lattice point `p` of the data resolution `r`, from its home face.
+    fn data_at_lattice(&self, p: IVec3, r: i32) -> f64 {
+        match home_face(p, r) {
+            Some(f) => {
+                let (i, j) = indices_on(f, p, r);
+                self.data(f, i, j)
+            }
+            None => f64::NAN,
+        }
+    }
+
+    /// The relief weight of data sample `(i, j)` of `face`: its largest difference to its four
+    /// neighbours (unfolded across edges; at a cube corner the three edge neighbours).
+    fn relief(&self, face: Face, i: i32, j: i32, detail: &DetailNoise) -> f64 {
+        let r = 1i32 << self.header.n;
+        let h = self.data(face, i, j);
+        let mut most = 0.0f64;
+        for (a, b) in [(i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)] {
+            let v = if (0..=r).contains(&a) && (0..=r).contains(&b) {
+                self.data(face, a, b)
+            } else {
+                unfold(face, r, a, b).map_or(f64::NAN, |p| self.data_at_lattice(p, r))
+            };
+            most = most.max((v - h).abs());
+        }
+        if h.is_nan() {
+            return f64::NAN;
+        }
+        detail.relief_weight(most, self.data_spacing())
+    }
+
+    /// Interpolated data at fractional sample indices `(s, t)` of `face`, and the relief weight
+    /// of the detail there (1 when the detail is off).
+    fn interpolate(&self, face: Face, s: f64, t: f64, interp: Interpolation, detail: &DetailNoise) -> (f64, f64) {
+        let r = 1i32 << self.header.n;
+        let rf = f64::from(r);
+        if !(s.is_finite() && t.is_finite()) {
+            return (f64::NAN, f64::NAN);
+        }
+        let (s, t) = (s.clamp(0.0, rf), t.clamp(0.0, rf));
+        let i0 = (s.floor() as i32).min(r - 1);
+        let j0 = (t.floor() as i32).min(r - 1);
+        let (fs, ft) = (s - f64::from(i0), t - f64::from(j0));
+        let value = match interp {
+            Interpolation::Bilinear => {
+                let a = self.data(face, i0, j0);
+                let b = self.data(face, i0 + 1, j0);
+                let c = self.data(face, i0, j0 + 1);
+                let d = self.data(face, i0 + 1, j0 + 1);
+                let lo = a + fs * (b - a);
+                let hi = c + fs * (d - c);
+                lo + ft * (hi - lo)
+            }
+            Interpolation::Bicubic => {
+                let ws = catmull_rom(fs);
+                let wt = catmull_rom(ft);
+                let mut total = 0.0;
+                for (dj, wj) in wt.iter().enumerate() {
+                    let j = j0 - 1 + dj as i32;
+                    let row: f64 = ws
+                        .iter()
+                        .enumerate()
+                        .map(|(di, wi)| wi * self.stencil(face, i0 - 1 + di as i32, j))
+                        .sum();
+                    total += wj * row;
+                }
+                total
+            }
+        };
+        if !detail.is_on() {
+            return (value, 1.0);
+        }
+        let a = self.relief(face, i0, j0, detail);
+        let b = self.relief(face, i0 + 1, j0, detail);
+        let c = self.relief(face, i0, j0 + 1, detail);
+        let d = self.relief(face, i0 + 1, j0 + 1, detail);
+        let lo = a + fs * (b - a);
+        let hi = c + fs * (d - c);
+        (value, lo + ft * (hi - lo))
+    }
+
+    /// The height, in metres above the datum's zero (the data's metres), at the canonical
+    /// lattice point `lattice` of resolution `m` (a power of two; coordinates in `[-m, m]`, on
+    /// the cube surface: one coordinate `= ±m`, all of the parity of `m`).
+    ///
+    /// When `m <= 2^n` the point is a data sample: its stored value is returned exactly (read
+    /// from the stored level of resolution `m`, or the coarsest overview when `m` is coarser;
+    /// all levels hold the same bits), with no noise. When `m > 2^n` the point lies between
+    /// samples: the interpolated data plus detail octaves `0 .. log2(m) - n` (the finer ones are
+    /// exactly zero at the point, so a coarse vertex is cheap and still exact). Face edge and
+    /// corner points are computed on one face chosen from the point alone (the first of
+    /// [`Face::ALL`] that holds it), so every caller gets the same bits.
+    ///
+    /// `NaN` for an invalid point or resolution, or when a tile cannot be read (see
+    /// [`CubeDem::verify`]).
+    pub fn height_at_lattice(&self, lattice: IVec3, m: i32, interp: Interpolation, detail: &DetailNoise) -> f64 {
+        if m <= 0 || m > MAX_LATTICE_RESOLUTION || m.count_ones() != 1 {
+            return f64::NAN;
+        }
+        if lattice.abs().max_element() > m || (lattice + IVec3::splat(m)) % 2 != IVec3::ZERO {
+            return f64::NAN;
+        }
+        let Some(face) = home_face(lattice, m) else {
+            return f64::NAN;
+        };
+        let n = self.header.n;
+        let big_n = 1i32 << n;
+        if m <= big_n {
+            let coarsest = big_n >> (self.header.levels - 1);
+            let r = m.max(coarsest);
+            let p = lattice * (r / m);
+            let level = n - r.trailing_zeros();
+            let Some(f) = home_face(p, r) else {
+                return f64::NAN;
+            };
+            let (i, j) = indices_on(f, p, r);
+            return self
+                .value(level, f.index(), i as u32, j as u32)
+                .map_or(f64::NAN, f64::from);
+        }
+        // Sample indices at the data resolution: exact (a power-of-two scale of integers).
+        let scale = f64::from(big_n) / (2.0 * f64::from(m));
+        let fr = face.frame();
+        let s = f64::from(fr.u.dot(lattice) + m) * scale;
+        let t = f64::from(fr.v.dot(lattice) + m) * scale;
+        let (value, weight) = self.interpolate(face, s, t, interp, detail);
+        if !detail.is_on() {
+            return value;
+        }
+        let octaves = m.trailing_zeros() - n;
+        value + weight * detail.sum(lattice.as_dvec3() * scale, octaves, self.data_spacing())
+    }
+
+    /// The height, in metres, in direction `dir` (any length), with detail octaves down to a
+    /// lattice spacing of `finest_spacing_m` metres (0 or less: all
+    /// [`MAX_DETAIL_OCTAVES`](crate::cube::MAX_DETAIL_OCTAVES)). Agrees with
+    /// [`CubeDem::height_at_lattice`] at lattice points to about 1e-6 m. `NaN` for a zero or
+    /// non-finite direction, a `NaN` spacing, or a tile that cannot be read.
+    pub fn height(&self, dir: DVec3, interp: Interpolation, detail: &DetailNoise, finest_spacing_m: f64) -> f64 {
+        if finest_spacing_m.is_nan() {
+            return f64::NAN;
+        }
+        let Some((face, u, v)) = sphere_to_face_uv(dir) else {
+            return f64::NAN;
+        };
+        let half = f64::from(1u32 << self.header.n) * 0.5;
+        let (value, weight) = self.interpolate(face, (u + 1.0) * half, (v + 1.0) * half, interp, detail);
+        if !detail.is_on() {
+            return value;
+        }
+        let spacing = self.data_spacing();
+        let mut octaves = 0;
+        while octaves < MAX_DETAIL_OCTAVES && spacing / f64::from(1u32 << octaves) >= finest_spacing_m {
+            octaves += 1;
+        }
+        value + weight * detail.sum(face_uv_to_cube(face, u, v) * half, octaves, spacing)
+    }
+}
