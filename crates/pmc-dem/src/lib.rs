@@ -42,6 +42,9 @@ mod header;
 mod read;
 mod source;
 
+mod netcdf_source;
+pub use netcdf_source::NetcdfSource;
+
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
 pub use header::MAX_HEADER_BYTES;

@@ -64,7 +64,11 @@ impl EquirectSource for EquirectDem {
         let Some(end) = end else {
             return Err(DemError::OutOfGrid {
                 file: self.source.clone(),
-                detail: format!("rows {row0}..{} asked of a grid of {} rows", row0.saturating_add(rows), self.height),
+                detail: format!(
+                    "rows {row0}..{} asked of a grid of {} rows",
+                    row0.saturating_add(rows),
+                    self.height
+                ),
             });
         };
         if out.len() != rows * w {
