@@ -44,6 +44,8 @@ mod source;
 
 mod netcdf_source;
 pub use netcdf_source::NetcdfSource;
+mod geotiff;
+pub use geotiff::{GeoTiffSource, MAX_CHUNK_ROW_CELLS};
 
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
