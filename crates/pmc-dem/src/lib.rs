@@ -46,6 +46,8 @@ mod netcdf_source;
 pub use netcdf_source::NetcdfSource;
 mod geotiff;
 pub use geotiff::{GeoTiffSource, MAX_CHUNK_ROW_CELLS};
+mod png16;
+pub use png16::PngExtent;
 
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
