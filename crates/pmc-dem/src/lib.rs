@@ -48,6 +48,7 @@ mod geotiff;
 pub use geotiff::{GeoTiffSource, MAX_CHUNK_ROW_CELLS};
 mod png16;
 pub use png16::PngExtent;
+pub mod fuzz;
 
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
