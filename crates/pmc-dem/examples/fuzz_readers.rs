@@ -36,13 +36,14 @@ fn main() {
         "{:<16} {:>12} {:>10} {:>12} {:>7}",
         "reader", "executions", "seconds", "execs/s", "panics"
     );
-    let mut total = (0u64, 0.0f64, 0usize);
+    let mut total = (0u64, 0.0f64, 0usize, 0u64);
     for report in fuzz::run(&targets, iterations, seed, Some(&out)) {
         let secs = report.elapsed.as_secs_f64();
         println!(
-            "{:<16} {:>12} {:>10.1} {:>12.0} {:>7}",
+            "{:<16} {:>12} {:>10} {:>10.1} {:>12.0} {:>7}",
             report.name,
             report.executions,
+            report.accepted,
             secs,
             report.executions as f64 / secs.max(1e-9),
             report.panics.len()
@@ -50,11 +51,13 @@ fn main() {
         total.0 += report.executions;
         total.1 += secs;
         total.2 += report.panics.len();
+        total.3 += report.accepted;
     }
     println!(
-        "{:<16} {:>12} {:>10.1} {:>12.0} {:>7}",
+        "{:<16} {:>12} {:>10} {:>10.1} {:>12.0} {:>7}",
         "total",
         total.0,
+        total.3,
         total.1,
         total.0 as f64 / total.1.max(1e-9),
         total.2

@@ -20,8 +20,8 @@ pub struct Target {
     pub name: &'static str,
     /// The real file whose damaged copies are parsed.
     pub seed: Vec<u8>,
-    /// Parses one input.
-    pub parse: fn(&[u8]),
+    /// Parses one input; returns whether the reader accepted it.
+    pub parse: fn(&[u8]) -> bool,
 }
 
 /// The files under `tests/fixtures` used as seeds (relative to the crate's directory).
@@ -67,8 +67,9 @@ fn consistent(dem: &EquirectDem) {
     }
 }
 
-/// Reads every row of a source in bands of 16 (refusals must name the file).
-fn all_rows(src: &dyn EquirectSource) {
+/// Reads every row of a source in bands of 16 (refusals must name the file); whether all were
+/// read.
+fn all_rows(src: &dyn EquirectSource) -> bool {
     let (w, h) = (src.width(), src.height());
     assert!(w >= 1 && h >= 1);
     let mut row0 = 0;
@@ -77,44 +78,69 @@ fn all_rows(src: &dyn EquirectSource) {
         let mut band = vec![0.0f32; rows * w];
         if let Err(e) = src.read_rows(row0, rows, &mut band) {
             named(&e);
-            return;
+            return false;
         }
         row0 += rows;
     }
+    true
 }
 
-fn parse_netcdf(bytes: &[u8]) {
+fn parse_netcdf(bytes: &[u8]) -> bool {
     match EquirectDem::from_netcdf_bytes("fuzz", bytes.to_vec(), None) {
-        Ok(dem) => consistent(&dem),
-        Err(e) => named(&e),
+        Ok(dem) => {
+            consistent(&dem);
+            true
+        }
+        Err(e) => {
+            named(&e);
+            false
+        }
     }
 }
 
-fn parse_netcdf_source(bytes: &[u8]) {
+fn parse_netcdf_source(bytes: &[u8]) -> bool {
     match NetcdfSource::from_bytes("fuzz", bytes.to_vec(), None) {
         Ok(src) => all_rows(&src),
-        Err(e) => named(&e),
+        Err(e) => {
+            named(&e);
+            false
+        }
     }
 }
 
-fn parse_geotiff(bytes: &[u8]) {
+fn parse_geotiff(bytes: &[u8]) -> bool {
     match EquirectDem::from_geotiff_bytes("fuzz", bytes.to_vec()) {
-        Ok(dem) => consistent(&dem),
-        Err(e) => named(&e),
+        Ok(dem) => {
+            consistent(&dem);
+            true
+        }
+        Err(e) => {
+            named(&e);
+            false
+        }
     }
 }
 
-fn parse_geotiff_source(bytes: &[u8]) {
+fn parse_geotiff_source(bytes: &[u8]) -> bool {
     match GeoTiffSource::from_bytes("fuzz", bytes.to_vec()) {
         Ok(src) => all_rows(&src),
-        Err(e) => named(&e),
+        Err(e) => {
+            named(&e);
+            false
+        }
     }
 }
 
-fn parse_png(bytes: &[u8]) {
+fn parse_png(bytes: &[u8]) -> bool {
     match EquirectDem::from_png16_bytes("fuzz", bytes, &PNG_EXTENT) {
-        Ok(dem) => consistent(&dem),
-        Err(e) => named(&e),
+        Ok(dem) => {
+            consistent(&dem);
+            true
+        }
+        Err(e) => {
+            named(&e);
+            false
+        }
     }
 }
 
@@ -302,6 +328,8 @@ pub struct Report {
     pub name: &'static str,
     /// Inputs parsed.
     pub executions: u64,
+    /// Inputs the reader accepted (a grid read, or every row of a source).
+    pub accepted: u64,
     /// Time spent.
     pub elapsed: Duration,
     /// The iterations whose input made the reader panic, with where each input was saved.
@@ -318,9 +346,12 @@ pub fn run(targets: &[Target], iterations: u64, seed: u64, save_to: Option<&Path
     for (index, target) in targets.iter().enumerate() {
         let start = Instant::now();
         let mut panics = Vec::new();
+        let mut accepted = 0;
         for i in 0..iterations {
             let bytes = input(target, seed, index, i);
-            if catch_unwind(AssertUnwindSafe(|| (target.parse)(&bytes))).is_err() {
+            let outcome = catch_unwind(AssertUnwindSafe(|| (target.parse)(&bytes)));
+            accepted += u64::from(matches!(outcome, Ok(true)));
+            if outcome.is_err() {
                 let saved = save_to.and_then(|dir| {
                     let path = dir.join(format!("{}-{seed}-{i}.bin", target.name));
                     std::fs::create_dir_all(dir).ok()?;
@@ -342,6 +373,7 @@ pub fn run(targets: &[Target], iterations: u64, seed: u64, save_to: Option<&Path
         reports.push(Report {
             name: target.name,
             executions: iterations,
+            accepted,
             elapsed: start.elapsed(),
             panics,
         });

@@ -1,13 +1,18 @@
-//! Digital elevation models on equirectangular grids, read from netCDF classic files: heights in
-//! metres at evenly spaced longitudes and latitudes, with bilinear sampling that wraps round the
-//! globe.
+//! Digital elevation models on equirectangular grids, read from netCDF classic, GeoTIFF and
+//! 16-bit PNG files: heights in metres at evenly spaced longitudes and latitudes, with bilinear
+//! sampling that wraps round the globe.
 //!
 //! [`EquirectDem::read_netcdf`] reads a netCDF classic (CDF-1) or 64-bit offset (CDF-2) file such
-//! as NOAA's ETOPO relief grids. The file's coordinate variables give the axes; the result is
-//! normalised to one layout (rows from south to north, columns from west to east, the first
-//! longitude in [-180, 180), a column repeated one turn later dropped) whatever the file's order.
+//! as NOAA's ETOPO relief grids; [`EquirectDem::read_geotiff`] a single-band GeoTIFF in
+//! longitudes and latitudes (strips or tiles, integer or float samples); and
+//! [`EquirectDem::read_png16`] a 16-bit grayscale PNG over an extent the caller gives
+//! ([`PngExtent`]). Every grid is normalised to one layout (rows from south to north, columns
+//! from west to east, the first longitude in [-180, 180), a column repeated one turn later
+//! dropped) whatever the file's order. [`NetcdfSource`] and [`GeoTiffSource`] read a band of
+//! rows at a time ([`EquirectSource`]), so that grids larger than memory can be imported.
 //! Input from outside is checked before it is trusted: every problem is a [`DemError`] naming the
-//! file, never a panic, and sizes are checked against the file before memory is reserved.
+//! file, never a panic (the readers are mutation-fuzzed, see [`fuzz`]), and sizes are checked
+//! against the file before memory is reserved.
 //!
 //! ```
 //! use pmc_dem::EquirectDem;
