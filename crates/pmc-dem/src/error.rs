@@ -280,6 +280,96 @@ pub enum DemError {
         /// What was asked.
         detail: String,
     },
+    /// The file given to the GeoTIFF reader is not a TIFF file: it does not start with `II*\0`
+    /// or `MM\0*` (or the BigTIFF signatures). Says what it looks like instead (a netCDF or PNG
+    /// file, say). Fix: check the path, or use the reader for that format.
+    #[error("{file}: not a TIFF file: {detail}")]
+    NotTiff {
+        /// The file.
+        file: String,
+        /// What was found instead.
+        detail: String,
+    },
+    /// The TIFF file is valid but uses something this reader does not read: several bands,
+    /// a sample type other than 8-, 16-, 32- or 64-bit integers or 32- or 64-bit floats, JPEG or
+    /// another compression than none, deflate, LZW or PackBits. Fix: convert it, for instance
+    /// with `gdal_translate -b 1 -ot Float32 -co COMPRESS=DEFLATE IN OUT`.
+    #[error("{file}: this TIFF cannot be read as an elevation model: {detail}; convert it, for instance with `gdal_translate -b 1 -ot Float32 -co COMPRESS=DEFLATE IN OUT`")]
+    TiffUnsupported {
+        /// The file.
+        file: String,
+        /// What was found.
+        detail: String,
+    },
+    /// The TIFF file is damaged: its directory or its compressed data cannot be decoded. Fix:
+    /// obtain an intact copy of the file.
+    #[error("{file}: the TIFF file is damaged: {detail}; obtain an intact copy of the file")]
+    TiffCorrupt {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// The TIFF file does not say where on Earth its pixels lie: the GeoTIFF tags
+    /// (ModelPixelScale with ModelTiepoint, or ModelTransformation, and the GeoKeyDirectory) are
+    /// missing or unusable (rotated, zero or not finite scales). Fix: georeference it, for
+    /// instance with `gdal_translate -a_srs EPSG:4326 -a_ullr WEST NORTH EAST SOUTH IN OUT`.
+    #[error("{file}: the file is not georeferenced as a longitude-latitude grid: {detail}; georeference it, for instance with `gdal_translate -a_srs EPSG:4326 -a_ullr WEST NORTH EAST SOUTH IN OUT`")]
+    NoGeoreference {
+        /// The file.
+        file: String,
+        /// What is missing or wrong.
+        detail: String,
+    },
+    /// The GeoTIFF is georeferenced in a projected (or geocentric) coordinate system, or in
+    /// angular units other than degrees; this reader needs longitudes and latitudes in degrees.
+    /// Fix: reproject it, for instance with `gdalwarp -t_srs EPSG:4326 IN OUT`.
+    #[error("{file}: the grid is not in geographic coordinates (longitude and latitude in degrees): {detail}; reproject it, for instance with `gdalwarp -t_srs EPSG:4326 IN OUT`")]
+    NotGeographic {
+        /// The file.
+        file: String,
+        /// The coordinate system found.
+        detail: String,
+    },
+    /// The file given to the PNG reader is not a PNG file (it does not start with the PNG
+    /// signature); says what it looks like instead. Fix: check the path.
+    #[error("{file}: not a PNG file: {detail}")]
+    NotPng {
+        /// The file.
+        file: String,
+        /// What was found instead.
+        detail: String,
+    },
+    /// The PNG file is not a single-channel 16-bit image (grayscale, 16 bits per sample), so its
+    /// values are not heights. Fix: export the heights as a 16-bit grayscale PNG, for instance
+    /// with `gdal_translate -of PNG -ot UInt16 IN OUT.png`.
+    #[error("{file}: the PNG holds {found}, not 16-bit grayscale heights; export the heights as a 16-bit grayscale PNG (for instance `gdal_translate -of PNG -ot UInt16 IN OUT.png`)")]
+    PngUnsupported {
+        /// The file.
+        file: String,
+        /// What the file holds (bit depth and colour type).
+        found: String,
+    },
+    /// The PNG file is damaged: a chunk, a checksum or the compressed data cannot be decoded, or
+    /// it ends early. Fix: obtain an intact copy of the file.
+    #[error("{file}: the PNG file is damaged: {detail}; obtain an intact copy of the file")]
+    PngCorrupt {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// The extent or value mapping given by the caller for a file that does not carry its own
+    /// (a PNG) is unusable: a bound or the scale or offset is not a finite number, west is not
+    /// less than east, south not less than north, a latitude outside [-90, 90], more than 360
+    /// degrees of longitude, or a zero scale. Fix: pass the file's true extent.
+    #[error("{file}: the extent given for the file is unusable: {detail}")]
+    InvalidExtent {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        detail: String,
+    },
 }
 
 /// The names in `items`, separated by commas, or `no variables` when there are none.
@@ -317,7 +407,16 @@ impl DemError {
             | DemError::CubeCorrupt { file, .. }
             | DemError::Write { file, .. }
             | DemError::InvalidOptions { file, .. }
-            | DemError::EmptySource { file } => file,
+            | DemError::EmptySource { file }
+            | DemError::NotTiff { file, .. }
+            | DemError::TiffUnsupported { file, .. }
+            | DemError::TiffCorrupt { file, .. }
+            | DemError::NoGeoreference { file, .. }
+            | DemError::NotGeographic { file, .. }
+            | DemError::NotPng { file, .. }
+            | DemError::PngUnsupported { file, .. }
+            | DemError::PngCorrupt { file, .. }
+            | DemError::InvalidExtent { file, .. } => file,
         }
     }
 }

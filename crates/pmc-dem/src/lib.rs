@@ -1,13 +1,19 @@
-//! Digital elevation models: equirectangular grids read from netCDF classic files (heights in
-//! metres at evenly spaced longitudes and latitudes, with bilinear sampling that wraps round the
-//! globe), and cube-face `.pmcdem` files made from them (see "Cube-face files" below).
+//! Digital elevation models: equirectangular grids read from netCDF classic, GeoTIFF and 16-bit
+//! PNG files (heights in metres at evenly spaced longitudes and latitudes, with bilinear sampling
+//! that wraps round the globe), and cube-face `.pmcdem` files made from them (see "Cube-face
+//! files" below).
 //!
 //! [`EquirectDem::read_netcdf`] reads a netCDF classic (CDF-1) or 64-bit offset (CDF-2) file such
-//! as NOAA's ETOPO relief grids. The file's coordinate variables give the axes; the result is
-//! normalised to one layout (rows from south to north, columns from west to east, the first
-//! longitude in [-180, 180), a column repeated one turn later dropped) whatever the file's order.
+//! as NOAA's ETOPO relief grids; [`EquirectDem::read_geotiff`] a single-band GeoTIFF in
+//! longitudes and latitudes (strips or tiles, integer or float samples); and
+//! [`EquirectDem::read_png16`] a 16-bit grayscale PNG over an extent the caller gives
+//! ([`PngExtent`]). Every grid is normalised to one layout (rows from south to north, columns
+//! from west to east, the first longitude in [-180, 180), a column repeated one turn later
+//! dropped) whatever the file's order. [`NetcdfSource`] and [`GeoTiffSource`] read a band of
+//! rows at a time ([`EquirectSource`]), so that grids larger than memory can be imported.
 //! Input from outside is checked before it is trusted: every problem is a [`DemError`] naming the
-//! file, never a panic, and sizes are checked against the file before memory is reserved.
+//! file, never a panic (the readers are mutation-fuzzed, see [`fuzz`]), and sizes are checked
+//! against the file before memory is reserved.
 //!
 //! ```
 //! use pmc_dem::EquirectDem;
@@ -82,6 +88,14 @@ mod error;
 mod header;
 mod read;
 mod source;
+
+mod netcdf_source;
+pub use netcdf_source::NetcdfSource;
+mod geotiff;
+pub use geotiff::{GeoTiffSource, MAX_CHUNK_ROW_CELLS};
+mod png16;
+pub use png16::PngExtent;
+pub mod fuzz;
 
 pub use cube::{import_cube, CubeDem, DetailNoise, ImportOptions, ImportReport, Interpolation};
 pub use dem::{DemStats, EquirectDem};

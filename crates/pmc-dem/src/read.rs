@@ -1,6 +1,6 @@
 //! Reading an [`EquirectDem`] from a netCDF classic file.
 
-use crate::axis::{self, AxisProblem, Longitudes};
+use crate::axis::{self, AxisProblem, Longitudes, Regular};
 use crate::dem::EquirectDem;
 use crate::error::DemError;
 use crate::header::{self, HeaderInfo, HeaderProblem, MAX_HEADER_BYTES};
@@ -40,31 +40,15 @@ impl EquirectDem {
     ///
     /// Errors: every [`DemError`] variant; each names `path` as displayed.
     pub fn read_netcdf(path: impl AsRef<Path>, variable: Option<&str>) -> Result<EquirectDem, DemError> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let io = |source: std::io::Error| DemError::Io {
-            file: file.clone(),
-            source,
-        };
-        let mut input = std::fs::File::open(path).map_err(io)?;
-        let len = input.metadata().map_err(io)?.len();
-        let mut want = FIRST_HEADER_READ;
-        let info = loop {
-            let n = want.min(len);
-            let mut prefix = vec![0; usize::try_from(n).unwrap_or(usize::MAX)];
-            input.seek(SeekFrom::Start(0)).map_err(io)?;
-            input.read_exact(&mut prefix).map_err(io)?;
-            match header::check(&prefix, len) {
-                Err(HeaderProblem::NeedMore) if n < len => want = want.saturating_mul(4),
-                result => break result.map_err(|p| header_error(&file, p, len))?,
-            }
-        };
-        input.seek(SeekFrom::Start(0)).map_err(io)?;
-        let source = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| file.clone());
-        load(file, source, input, len, &info, variable)
+        let opened = open_checked(path.as_ref())?;
+        load(
+            opened.file,
+            opened.source,
+            opened.input,
+            opened.len,
+            &opened.info,
+            variable,
+        )
     }
 
     /// Reads the elevation grid of a netCDF classic file held in memory; `name` stands for the
@@ -72,7 +56,7 @@ impl EquirectDem {
     /// [`read_netcdf`](Self::read_netcdf).
     pub fn from_netcdf_bytes(name: &str, bytes: Vec<u8>, variable: Option<&str>) -> Result<EquirectDem, DemError> {
         let len = bytes.len() as u64;
-        let info = header::check(&bytes, len).map_err(|p| header_error(name, p, len))?;
+        let info = check_bytes(name, &bytes)?;
         load(
             name.to_owned(),
             name.to_owned(),
@@ -82,6 +66,65 @@ impl EquirectDem {
             variable,
         )
     }
+}
+
+/// A netCDF file opened, its header through the bounds check.
+pub(crate) struct CheckedFile {
+    /// The path as displayed, for messages.
+    pub file: String,
+    /// The file's name (its last path component).
+    pub source: String,
+    /// The file, positioned at its start.
+    pub input: std::fs::File,
+    /// Its length in bytes.
+    pub len: u64,
+    /// What the bounds check found.
+    pub info: HeaderInfo,
+}
+
+/// Opens the file at `path` and checks its header's bounds, reading no more of it than the
+/// header needs.
+pub(crate) fn open_checked(path: &Path) -> Result<CheckedFile, DemError> {
+    let file = path.display().to_string();
+    let io = |source: std::io::Error| DemError::Io {
+        file: file.clone(),
+        source,
+    };
+    let mut input = std::fs::File::open(path).map_err(io)?;
+    let len = input.metadata().map_err(io)?.len();
+    let mut want = FIRST_HEADER_READ;
+    let info = loop {
+        let n = want.min(len);
+        let mut prefix = vec![0; usize::try_from(n).unwrap_or(usize::MAX)];
+        input.seek(SeekFrom::Start(0)).map_err(io)?;
+        input.read_exact(&mut prefix).map_err(io)?;
+        match header::check(&prefix, len) {
+            Err(HeaderProblem::NeedMore) if n < len => want = want.saturating_mul(4),
+            result => break result.map_err(|p| header_error(&file, p, len))?,
+        }
+    };
+    input.seek(SeekFrom::Start(0)).map_err(io)?;
+    let source = file_name(path);
+    Ok(CheckedFile {
+        file,
+        source,
+        input,
+        len,
+        info,
+    })
+}
+
+/// The last component of `path`, or the whole path displayed when it has none.
+pub(crate) fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// Checks the header of a netCDF file held in memory.
+pub(crate) fn check_bytes(name: &str, bytes: &[u8]) -> Result<HeaderInfo, DemError> {
+    let len = bytes.len() as u64;
+    header::check(bytes, len).map_err(|p| header_error(name, p, len))
 }
 
 /// The error for a header that failed the bounds check.
@@ -141,6 +184,81 @@ fn netcdf_error(file: &str, e: ReadError) -> DemError {
     DemError::Corrupt { file, detail }
 }
 
+/// A grid variable chosen and its axes read and checked; its values not yet read.
+pub(crate) struct Prepared {
+    /// The `netcdf3` reader, positioned anywhere.
+    pub reader: FileReader,
+    /// The grid variable's name.
+    pub variable: String,
+    /// Where the file's values go in the grid.
+    pub layout: Layout,
+    /// How stored values become heights.
+    pub values: Values,
+    /// The latitude axis, in increasing order.
+    pub lat: Regular,
+}
+
+/// Chooses the grid variable of a file whose header passed the bounds check, reads and checks
+/// its axes and packing, and checks that its data lie within the file. Reads no grid values.
+pub(crate) fn prepare<R: Read + Seek + 'static>(
+    file: &str,
+    input: R,
+    len: u64,
+    info: &HeaderInfo,
+    variable: Option<&str>,
+) -> Result<Prepared, DemError> {
+    let mut reader = FileReader::open_seek_read(file, Box::new(input)).map_err(|e| netcdf_error(file, e))?;
+    let plan = plan(file, reader.data_set(), variable)?;
+    let width_in = plan.lon_dim_size as u64;
+    let height_in = plan.lat_dim_size as u64;
+    if width_in.saturating_mul(height_in) > MAX_CELLS {
+        return Err(DemError::TooLarge {
+            file: file.to_owned(),
+            width: width_in,
+            height: height_in,
+            limit: MAX_CELLS,
+        });
+    }
+    for name in [&plan.lon_var, &plan.lat_var, &plan.grid_var] {
+        check_extent(file, info, name, len)?;
+    }
+
+    let (lon_values, lon_slack) = read_axis(file, &mut reader, &plan.lon_var)?;
+    let lon_label = format!("longitude ({})", plan.lon_var);
+    let lon = axis::regular(&lon_values, lon_slack.0, lon_slack.1)
+        .and_then(|a| axis::longitudes(a, lon_values.len()))
+        .map_err(|p| axis_error(file, &lon_label, p))?;
+    let (lat_values, lat_slack) = read_axis(file, &mut reader, &plan.lat_var)?;
+    let lat_label = format!("latitude ({})", plan.lat_var);
+    let lat = axis::regular(&lat_values, lat_slack.0, lat_slack.1)
+        .and_then(|a| axis::latitudes(a, lat_values.len()))
+        .map_err(|p| axis_error(file, &lat_label, p))?;
+
+    let var = reader
+        .data_set()
+        .get_var(&plan.grid_var)
+        .ok_or_else(|| DemError::VariableNotFound {
+            file: file.to_owned(),
+            name: plan.grid_var.clone(),
+            variables: Vec::new(),
+        })?;
+    let values = Values::new(&Packing::of(file, var)?, var.data_type());
+    let layout = Layout {
+        lon_first_dim: plan.lon_dim_index == 0,
+        lon_in: plan.lon_dim_size,
+        lat_in: plan.lat_dim_size,
+        lon,
+        lat_reversed: lat.reversed,
+    };
+    Ok(Prepared {
+        reader,
+        variable: plan.grid_var,
+        layout,
+        values,
+        lat,
+    })
+}
+
 /// Reads the grid once the header has passed the bounds check.
 fn load<R: Read + Seek + 'static>(
     file: String,
@@ -150,64 +268,26 @@ fn load<R: Read + Seek + 'static>(
     info: &HeaderInfo,
     variable: Option<&str>,
 ) -> Result<EquirectDem, DemError> {
-    let mut reader = FileReader::open_seek_read(&file, Box::new(input)).map_err(|e| netcdf_error(&file, e))?;
-    let plan = plan(&file, reader.data_set(), variable)?;
-    let width_in = plan.lon_dim_size as u64;
-    let height_in = plan.lat_dim_size as u64;
-    if width_in.saturating_mul(height_in) > MAX_CELLS {
-        return Err(DemError::TooLarge {
-            file,
-            width: width_in,
-            height: height_in,
-            limit: MAX_CELLS,
-        });
-    }
-    for name in [&plan.lon_var, &plan.lat_var, &plan.grid_var] {
-        check_extent(&file, info, name, len)?;
-    }
-
-    let (lon_values, lon_slack) = read_axis(&file, &mut reader, &plan.lon_var)?;
-    let lon_label = format!("longitude ({})", plan.lon_var);
-    let lon = axis::regular(&lon_values, lon_slack.0, lon_slack.1)
-        .and_then(|a| axis::longitudes(a, lon_values.len()))
-        .map_err(|p| axis_error(&file, &lon_label, p))?;
-    let (lat_values, lat_slack) = read_axis(&file, &mut reader, &plan.lat_var)?;
-    let lat_label = format!("latitude ({})", plan.lat_var);
-    let lat = axis::regular(&lat_values, lat_slack.0, lat_slack.1)
-        .and_then(|a| axis::latitudes(a, lat_values.len()))
-        .map_err(|p| axis_error(&file, &lat_label, p))?;
-
-    let var = reader
-        .data_set()
-        .get_var(&plan.grid_var)
-        .ok_or_else(|| DemError::VariableNotFound {
-            file: file.clone(),
-            name: plan.grid_var.clone(),
-            variables: Vec::new(),
-        })?;
-    let packing = Packing::of(&file, var)?;
+    let Prepared {
+        mut reader,
+        variable,
+        layout,
+        values,
+        lat,
+    } = prepare(&file, input, len, info, variable)?;
     let raw = reader
-        .read_var(&plan.grid_var)
-        .map_err(|e| data_error(&file, info, &plan.grid_var, len, e))?;
-    let layout = Layout {
-        lon_first_dim: plan.lon_dim_index == 0,
-        lon_in: plan.lon_dim_size,
-        lat_in: plan.lat_dim_size,
-        lon,
-        lat_reversed: lat.reversed,
-    };
-    let heights = decode(raw, &layout, &packing);
+        .read_var(&variable)
+        .map_err(|e| data_error(&file, info, &variable, len, e))?;
+    let heights = decode(raw, &layout, &values);
     if heights.iter().all(|v| v.is_nan()) {
-        return Err(DemError::NoValidData {
-            file,
-            variable: plan.grid_var,
-        });
+        return Err(DemError::NoValidData { file, variable });
     }
+    let lon = layout.lon;
     Ok(EquirectDem {
         source,
-        variable: plan.grid_var,
+        variable,
         width: lon.width,
-        height: plan.lat_dim_size,
+        height: layout.lat_in,
         lon_first: lon.first,
         lon_step: lon.step,
         lat_first: lat.first,
@@ -470,7 +550,8 @@ fn read_axis(file: &str, reader: &mut FileReader, name: &str) -> Result<(Vec<f64
     Ok((values, (relative, absolute)))
 }
 
-fn axis_error(file: &str, axis: &str, p: AxisProblem) -> DemError {
+/// The error for an unusable axis; `axis` names it as `longitude (VAR)` or `latitude (VAR)`.
+pub(crate) fn axis_error(file: &str, axis: &str, p: AxisProblem) -> DemError {
     let file = file.to_owned();
     let axis = axis.to_owned();
     match p {
@@ -557,25 +638,114 @@ impl Packing {
         Ok(Packing { scale, offset, fills })
     }
 
-    fn is_packed(&self) -> bool {
-        self.scale.is_some() || self.offset.is_some()
-    }
-
     fn apply(&self, v: f64) -> f64 {
         v * self.scale.unwrap_or(1.0) + self.offset.unwrap_or(0.0)
     }
 }
 
+/// How the stored values of one variable become heights: its type, packing and missing values.
+/// The one conversion used by both the whole-grid reader and [`NetcdfSource`](crate::NetcdfSource),
+/// so that both give the same bits.
+pub(crate) struct Values {
+    data_type: DataType,
+    packing: Packing,
+    /// The fill values as floats (compared with `float` values).
+    fills_f32: Vec<f32>,
+    /// The fill values that are whole numbers (compared with integer values).
+    fills_int: Vec<i64>,
+}
+
+impl Values {
+    fn new(packing: &Packing, data_type: DataType) -> Values {
+        let fills_int = packing
+            .fills
+            .iter()
+            .filter(|f| f.fract() == 0.0 && f.abs() < 9.0e15)
+            .map(|&f| f as i64)
+            .collect();
+        Values {
+            data_type,
+            fills_f32: packing.fills.iter().map(|&f| f as f32).collect(),
+            fills_int,
+            packing: Packing {
+                scale: packing.scale,
+                offset: packing.offset,
+                fills: packing.fills.clone(),
+            },
+        }
+    }
+
+    /// Bytes of one stored value.
+    pub fn size(&self) -> usize {
+        match self.data_type {
+            DataType::I8 | DataType::U8 => 1,
+            DataType::I16 => 2,
+            DataType::I32 | DataType::F32 => 4,
+            DataType::F64 => 8,
+        }
+    }
+
+    /// The height of a packed or integer value `v`, `NaN` if not finite.
+    fn height(&self, v: f64) -> f32 {
+        let h = self.packing.apply(v) as f32;
+        if h.is_finite() {
+            h
+        } else {
+            f32::NAN
+        }
+    }
+
+    fn height_of_f32(&self, x: f32) -> f32 {
+        if !x.is_finite() || self.fills_f32.contains(&x) {
+            f32::NAN
+        } else if self.packing.scale.is_some() || self.packing.offset.is_some() {
+            self.height(f64::from(x))
+        } else {
+            x
+        }
+    }
+
+    fn height_of_f64(&self, x: f64) -> f32 {
+        if !x.is_finite() || self.packing.fills.contains(&x) {
+            f32::NAN
+        } else {
+            self.height(x)
+        }
+    }
+
+    fn height_of_int(&self, x: i64) -> f32 {
+        if self.fills_int.contains(&x) {
+            f32::NAN
+        } else {
+            self.height(x as f64)
+        }
+    }
+
+    /// The height of one value stored big-endian in `b` (`size()` bytes), as the file holds it.
+    pub fn height_of_be_bytes(&self, b: &[u8]) -> f32 {
+        match self.data_type {
+            DataType::I8 => self.height_of_int(i64::from(b[0] as i8)),
+            DataType::U8 => self.height_of_int(i64::from(b[0])),
+            DataType::I16 => self.height_of_int(i64::from(i16::from_be_bytes([b[0], b[1]]))),
+            DataType::I32 => self.height_of_int(i64::from(i32::from_be_bytes([b[0], b[1], b[2], b[3]]))),
+            DataType::F32 => self.height_of_f32(f32::from_be_bytes([b[0], b[1], b[2], b[3]])),
+            DataType::F64 => self.height_of_f64(f64::from_be_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])),
+        }
+    }
+}
+
 /// Where the file's values go in the grid.
-struct Layout {
+pub(crate) struct Layout {
     /// Whether longitude is the grid variable's first (outer) dimension.
-    lon_first_dim: bool,
+    pub lon_first_dim: bool,
     /// Longitudes in the file.
-    lon_in: usize,
+    pub lon_in: usize,
     /// Latitudes in the file (= rows of the grid).
-    lat_in: usize,
-    lon: Longitudes,
-    lat_reversed: bool,
+    pub lat_in: usize,
+    /// The longitude axis, normalised.
+    pub lon: Longitudes,
+    /// Whether the file stores latitudes in decreasing order.
+    pub lat_reversed: bool,
 }
 
 impl Layout {
@@ -584,10 +754,27 @@ impl Layout {
         !self.lon_first_dim && !self.lon.reversed && !self.lat_reversed && self.lon.width == self.lon_in
     }
 
+    /// The file's latitude index of the grid's row `row`.
+    pub fn file_lat(&self, row: usize) -> usize {
+        if self.lat_reversed {
+            self.lat_in - 1 - row
+        } else {
+            row
+        }
+    }
+
+    /// The file's longitude index of the grid's column `col`.
+    pub fn file_lon(&self, col: usize) -> usize {
+        if self.lon.reversed {
+            self.lon_in - 1 - col
+        } else {
+            col
+        }
+    }
+
     /// Index in the file's values of the grid's `(col, row)`.
     fn file_index(&self, col: usize, row: usize) -> usize {
-        let i_lat = if self.lat_reversed { self.lat_in - 1 - row } else { row };
-        let i_lon = if self.lon.reversed { self.lon_in - 1 - col } else { col };
+        let (i_lat, i_lon) = (self.file_lat(row), self.file_lon(col));
         if self.lon_first_dim {
             i_lon * self.lat_in + i_lat
         } else {
@@ -597,95 +784,21 @@ impl Layout {
 }
 
 /// Heights in grid order from the file's values; missing values become `NaN`.
-fn decode(raw: DataVector, layout: &Layout, packing: &Packing) -> Vec<f32> {
-    // Each type compares its stored values with the fill values converted to that type.
-    fn fills_as<T: Copy>(fills: &[f64], cast: impl Fn(f64) -> Option<T>) -> Vec<T> {
-        fills.iter().filter_map(|&f| cast(f)).collect()
-    }
-    fn int_cast<T: TryFrom<i64>>(f: f64) -> Option<T> {
-        if f.fract() == 0.0 && f.abs() < 9.0e15 {
-            T::try_from(f as i64).ok()
-        } else {
-            None
-        }
-    }
-    let height = |v: f64| -> f32 {
-        let h = packing.apply(v) as f32;
-        if h.is_finite() {
-            h
-        } else {
-            f32::NAN
-        }
-    };
+fn decode(raw: DataVector, layout: &Layout, values: &Values) -> Vec<f32> {
     match raw {
         DataVector::F32(mut v) => {
-            let fills = fills_as(&packing.fills, |f| Some(f as f32));
-            let one = |x: f32| -> f32 {
-                if !x.is_finite() || fills.contains(&x) {
-                    f32::NAN
-                } else if packing.is_packed() {
-                    height(f64::from(x))
-                } else {
-                    x
-                }
-            };
             if layout.is_identity() {
-                v.iter_mut().for_each(|x| *x = one(*x));
+                v.iter_mut().for_each(|x| *x = values.height_of_f32(*x));
                 v
             } else {
-                reorder(layout, |i| one(v[i]))
+                reorder(layout, |i| values.height_of_f32(v[i]))
             }
         }
-        DataVector::F64(v) => {
-            let one = |x: f64| -> f32 {
-                if !x.is_finite() || packing.fills.contains(&x) {
-                    f32::NAN
-                } else {
-                    height(x)
-                }
-            };
-            reorder(layout, |i| one(v[i]))
-        }
-        DataVector::I32(v) => {
-            let fills: Vec<i32> = fills_as(&packing.fills, int_cast);
-            reorder(layout, |i| {
-                if fills.contains(&v[i]) {
-                    f32::NAN
-                } else {
-                    height(f64::from(v[i]))
-                }
-            })
-        }
-        DataVector::I16(v) => {
-            let fills: Vec<i16> = fills_as(&packing.fills, int_cast);
-            reorder(layout, |i| {
-                if fills.contains(&v[i]) {
-                    f32::NAN
-                } else {
-                    height(f64::from(v[i]))
-                }
-            })
-        }
-        DataVector::I8(v) => {
-            let fills: Vec<i8> = fills_as(&packing.fills, int_cast);
-            reorder(layout, |i| {
-                if fills.contains(&v[i]) {
-                    f32::NAN
-                } else {
-                    height(f64::from(v[i]))
-                }
-            })
-        }
-        DataVector::U8(v) => {
-            let fills: Vec<u8> = fills_as(&packing.fills, int_cast);
-            reorder(layout, |i| {
-                if fills.contains(&v[i]) {
-                    f32::NAN
-                } else {
-                    height(f64::from(v[i]))
-                }
-            })
-        }
+        DataVector::F64(v) => reorder(layout, |i| values.height_of_f64(v[i])),
+        DataVector::I32(v) => reorder(layout, |i| values.height_of_int(i64::from(v[i]))),
+        DataVector::I16(v) => reorder(layout, |i| values.height_of_int(i64::from(v[i]))),
+        DataVector::I8(v) => reorder(layout, |i| values.height_of_int(i64::from(v[i]))),
+        DataVector::U8(v) => reorder(layout, |i| values.height_of_int(i64::from(v[i]))),
     }
 }
 

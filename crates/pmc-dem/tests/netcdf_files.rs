@@ -3,7 +3,7 @@
 //! for its variant and for naming the file.
 
 use netcdf3::{DataSet, DataVector, FileWriter, Version};
-use pmc_dem::{DemError, EquirectDem, MAX_CELLS, MAX_HEADER_BYTES};
+use pmc_dem::{DemError, EquirectDem, EquirectSource, NetcdfSource, MAX_CELLS, MAX_HEADER_BYTES};
 use std::path::{Path, PathBuf};
 
 const FILL: f32 = -1e34;
@@ -34,6 +34,41 @@ fn refusal_of_bytes(name: &str, bytes: Vec<u8>, variable: Option<&str>) -> DemEr
     let e = EquirectDem::from_netcdf_bytes(name, bytes, variable).unwrap_err();
     assert!(e.to_string().contains(name), "message does not name {name}: {e}");
     e
+}
+
+/// Checks that every row read through `src`, one band of three rows at a time, is bit for bit
+/// the grid `dem`, with the same axes.
+fn same_rows(dem: &EquirectDem, src: &NetcdfSource) {
+    assert_eq!((src.width(), src.height()), (dem.width(), dem.height()));
+    assert_eq!((src.lon_first(), src.lon_step()), (dem.lon_first(), dem.lon_step()));
+    assert_eq!((src.lat_first(), src.lat_step()), (dem.lat_first(), dem.lat_step()));
+    assert_eq!(src.wraps_in_longitude(), dem.wraps_in_longitude());
+    assert_eq!(src.variable(), dem.variable());
+    let w = dem.width();
+    let mut row0 = 0;
+    while row0 < dem.height() {
+        let rows = 3.min(dem.height() - row0);
+        let mut band = vec![0.0f32; rows * w];
+        src.read_rows(row0, rows, &mut band).unwrap();
+        let want = &dem.heights()[row0 * w..(row0 + rows) * w];
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&band), bits(want), "rows {row0}..{}", row0 + rows);
+        row0 += rows;
+    }
+}
+
+/// Reads `path` whole, and checks that [`NetcdfSource`] reads the same rows.
+fn read_both(path: impl AsRef<Path>, variable: Option<&str>) -> EquirectDem {
+    let dem = EquirectDem::read_netcdf(path.as_ref(), variable).unwrap();
+    same_rows(&dem, &NetcdfSource::open(path.as_ref(), variable).unwrap());
+    dem
+}
+
+/// Reads `bytes` whole, and checks that [`NetcdfSource`] reads the same rows.
+fn both_from_bytes(name: &str, bytes: Vec<u8>, variable: Option<&str>) -> EquirectDem {
+    let dem = EquirectDem::from_netcdf_bytes(name, bytes.clone(), variable).unwrap();
+    same_rows(&dem, &NetcdfSource::from_bytes(name, bytes, variable).unwrap());
+    dem
 }
 
 /// A netCDF data set to write, with its data.
@@ -275,7 +310,7 @@ fn a_named_variable_must_exist_and_be_a_grid() {
     );
     assert!(e.to_string().contains("z(lat, lon) float"), "{e}");
     assert!(matches!(refusal(&p, Some("lat")), DemError::UnsuitableVariable { .. }));
-    assert_eq!(EquirectDem::read_netcdf(&p, Some("z")).unwrap().width(), 4);
+    assert_eq!(read_both(&p, Some("z")).width(), 4);
 }
 
 #[test]
@@ -288,7 +323,7 @@ fn several_candidate_grids_must_be_named() {
         matches!(&e, DemError::AmbiguousVariable { candidates, .. } if candidates.len() == 2),
         "{e}"
     );
-    let slope = EquirectDem::read_netcdf(&p, Some("slope")).unwrap();
+    let slope = read_both(&p, Some("slope"));
     assert_eq!(slope.value(3, 2), Some(0.5));
 }
 
@@ -321,7 +356,7 @@ fn axes_are_told_apart_by_units_then_attributes_then_names_then_order() {
         .text("b", "units", "degrees_north")
         .var("z", &["a", "b"], DataVector::F32(z_lon_lat.clone()))
         .write("transposed");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.width(), dem.height(), dem.lon(1), dem.lat(1)), (4, 3, 12.0, 0.0));
     assert_eq!(dem.heights(), &ramp(4, 3)[..]);
 
@@ -334,7 +369,7 @@ fn axes_are_told_apart_by_units_then_attributes_then_names_then_order() {
         .var("b", &["b"], DataVector::F64(lat.clone()))
         .var("z", &["a", "b"], DataVector::F32(z_lon_lat))
         .write("axis-attribute");
-    assert_eq!(EquirectDem::read_netcdf(&p, None).unwrap().heights(), &ramp(4, 3)[..]);
+    assert_eq!(read_both(&p, None).heights(), &ramp(4, 3)[..]);
 
     // By name, with coordinate variables named otherwise than their dimensions.
     let p = Nc::new()
@@ -344,7 +379,7 @@ fn axes_are_told_apart_by_units_then_attributes_then_names_then_order() {
         .var("longitude", &["j"], DataVector::F64(lon.clone()))
         .var("z", &["i", "j"], DataVector::F32(ramp(4, 3)))
         .write("names");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.lon(3), dem.lat(2)), (16.0, 5.0));
 
     // Nothing to go by: the last dimension is the longitude.
@@ -355,7 +390,7 @@ fn axes_are_told_apart_by_units_then_attributes_then_names_then_order() {
         .var("q", &["q"], DataVector::F64(lon))
         .var("z", &["p", "q"], DataVector::F32(ramp(4, 3)))
         .write("order");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.width(), dem.lon(3), dem.lat(2)), (4, 16.0, 5.0));
 }
 
@@ -420,7 +455,7 @@ fn latitudes_outside_the_globe_are_refused() {
 fn descending_latitudes_are_stored_south_first() {
     let lat = steps(45.0, -45.0, 3); // 45, 0, -45
     let p = grid(steps(0.0, 90.0, 4), lat, ramp(4, 3)).write("descending");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.lat_first(), dem.lat_step()), (-45.0, 45.0));
     // The file's last row (at -45) is row 0.
     for col in 0..4 {
@@ -434,7 +469,7 @@ fn descending_latitudes_are_stored_south_first() {
 #[test]
 fn descending_longitudes_are_stored_west_first() {
     let p = grid(steps(270.0, -90.0, 4), steps(0.0, 1.0, 2), ramp(4, 2)).write("descending-lon");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!(
         (dem.lon_first(), dem.lon_step(), dem.wraps_in_longitude()),
         (0.0, 90.0, true)
@@ -450,7 +485,7 @@ fn a_last_column_repeating_the_first_is_dropped() {
         .flat_map(|r| (0..5).map(move |c| (100 * r + c % 4) as f32))
         .collect();
     let p = grid(steps(20.0, 90.0, 5), steps(-45.0, 45.0, 3), z).write("repeated");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.width(), dem.lon_first(), dem.lon_step()), (4, 20.0, 90.0));
     assert!(dem.wraps_in_longitude());
     assert_eq!(dem.heights(), &ramp(4, 3)[..]);
@@ -461,7 +496,7 @@ fn a_last_column_repeating_the_first_is_dropped() {
 #[test]
 fn regional_grids_do_not_wrap_and_longitudes_are_normalised() {
     let p = grid(steps(190.0, 10.0, 4), steps(0.0, 10.0, 2), ramp(4, 2)).write("regional");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.lon_first(), dem.wraps_in_longitude()), (-170.0, false));
     assert_eq!(dem.sample_bilinear(0.0, 195.0), Some(0.5));
     assert_eq!(dem.sample_bilinear(0.0, -165.0), Some(0.5));
@@ -489,7 +524,7 @@ fn fill_values_and_nan_mixed_in_are_missing_samples() {
     let p = grid(steps(0.0, 90.0, 4), steps(-45.0, 45.0, 3), z)
         .f32_attr("z", "missing_value", -999.0)
         .write("mixed");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.value(1, 0), dem.value(2, 1), dem.value(3, 2)), (None, None, None));
     assert_eq!(dem.value(0, 0), Some(0.0));
     let stats = dem.stats();
@@ -524,7 +559,7 @@ fn packed_integers_are_scaled_and_their_fill_value_is_missing() {
     let attr = [b"\0\0\0\x0a_FillValue\0\0\0\0\0\x03\0\0\0\x01\x80\x01".as_slice()].concat();
     let at = bytes.windows(attr.len()).position(|w| w == attr).unwrap() + attr.len();
     bytes[at..at + 2].fill(0);
-    let dem = EquirectDem::from_netcdf_bytes("packed.nc", bytes, None).unwrap();
+    let dem = both_from_bytes("packed.nc", bytes, None);
     assert_eq!(dem.heights()[..3], [-100.0, -99.5, -99.0]);
     assert_eq!(dem.value(3, 0), None);
     assert_eq!(dem.value(3, 1), Some(-93.5));
@@ -543,15 +578,15 @@ fn without_fill_attributes_the_netcdf_default_fill_is_missing() {
             DataVector::F32(vec![1.0, netcdf3::NC_FILL_F32, 3.0, 4.0, 5.0, 6.0]),
         )
         .write("default-fill");
-    let dem = EquirectDem::read_netcdf(&p, None).unwrap();
+    let dem = read_both(&p, None);
     assert_eq!((dem.value(1, 0), dem.stats().missing), (None, 1));
 }
 
 #[test]
 fn sixty_four_bit_offset_files_read_like_classic_ones() {
     let nc = grid(steps(0.0, 90.0, 4), steps(-45.0, 45.0, 3), ramp(4, 3));
-    let classic = EquirectDem::read_netcdf(nc.write_as("cdf1", "a.nc", Version::Classic), None).unwrap();
-    let cdf2 = EquirectDem::read_netcdf(nc.write_as("cdf2", "a.nc", Version::Offset64Bit), None).unwrap();
+    let classic = read_both(nc.write_as("cdf1", "a.nc", Version::Classic), None);
+    let cdf2 = read_both(nc.write_as("cdf2", "a.nc", Version::Offset64Bit), None);
     assert_eq!(classic.heights(), cdf2.heights());
     assert_eq!(format!("{classic:?}"), format!("{cdf2:?}"));
 }
@@ -568,11 +603,11 @@ fn latitudes_along_the_record_dimension_read_like_fixed_ones() {
         .text("lon", "units", "degrees_east")
         .var("z", &["lat", "lon"], DataVector::F32(ramp(4, 3)));
     let mut bytes = std::fs::read(nc.write("records")).unwrap();
-    let dem = EquirectDem::from_netcdf_bytes("records.nc", bytes.clone(), None).unwrap();
+    let dem = both_from_bytes("records.nc", bytes.clone(), None);
     assert_eq!((dem.lat(2), dem.heights()), (45.0, &ramp(4, 3)[..]));
     // The number of records left to be computed from the file size (a streamed file).
     bytes[4..8].copy_from_slice(&u32::MAX.to_be_bytes());
-    let dem = EquirectDem::from_netcdf_bytes("streamed.nc", bytes.clone(), None).unwrap();
+    let dem = both_from_bytes("streamed.nc", bytes.clone(), None);
     assert_eq!(dem.heights(), &ramp(4, 3)[..]);
     // Records cut short.
     bytes[4..8].copy_from_slice(&3u32.to_be_bytes());
@@ -639,7 +674,7 @@ fn a_huge_header_is_refused_before_it_is_decoded() {
     );
     // A long history within the limit is read.
     let p = history(100_000).write("long-history");
-    assert_eq!(EquirectDem::read_netcdf(&p, None).unwrap().heights(), &ramp(4, 3)[..]);
+    assert_eq!(read_both(&p, None).heights(), &ramp(4, 3)[..]);
     for test in ["huge-header", "long-history"] {
         std::fs::remove_dir_all(dir(test)).unwrap();
     }
