@@ -25,12 +25,25 @@ export interface FaceInfo {
   v: Vec3Tuple;
 }
 
+/** `terrain` of `GET /api/v1/planet`: a preset, or an elevation model served by this server. */
+export interface TerrainInfo {
+  kind: 'preset' | 'dem';
+  /** The preset's name, or `dem` and the elevation file's name. */
+  name: string;
+  seed: string;
+  file?: string;
+  interpolation?: string;
+}
+
 export interface PlanetInfo {
   format: string;
   version: number;
-  preset: string;
+  /** The preset, or null when the planet is made from an elevation model (see `terrain`). */
+  preset: string | null;
   /** A decimal u64, kept as a string. */
   seed: string;
+  /** What the planet is made of. */
+  terrain?: TerrainInfo;
   presets: PresetInfo[];
   layout: Layout;
   radius: number;

@@ -207,6 +207,8 @@ export class App {
 
   private params: PlanetParams | null = null;
   private choice: { preset?: string; seed?: string } = {};
+  /** The name of the elevation-model planet the server serves, once seen. */
+  private servedTerrain: string | null = null;
   private planetRequest = 0;
   private planetBusy: string | null = null;
 
@@ -356,7 +358,10 @@ export class App {
 
   private applyPlanet(info: PlanetInfo): void {
     this.params = planetParams(info);
-    this.choice = { preset: info.preset, seed: info.seed };
+    // An elevation-model planet has no preset: it is the server's own planet, asked for with
+    // no preset parameter (the picker lists it under the empty value).
+    if (info.preset === null) this.servedTerrain = info.terrain?.name ?? 'elevation model';
+    this.choice = { ...(info.preset !== null ? { preset: info.preset } : {}), seed: info.seed };
     const lod = lodPlanetOf(info);
     this.lodPlanet = lod.planet;
     this.levelZeroOnly = lod.levelZeroOnly;
@@ -373,8 +378,11 @@ export class App {
     const shape = this.params.shape;
     if (!Number.isFinite(this.state.alt)) this.state.alt = 1.6 * shape.outer;
     this.clampAltitude();
-    this.ui.setPresets(info.presets, info.preset);
-    this.ui.setPlanet(info.preset, info.seed);
+    const served = this.servedTerrain;
+    const presets =
+      served === null ? info.presets : [{ name: '', label: served, description: 'the real planet this server serves' }, ...info.presets];
+    this.ui.setPresets(presets, info.preset ?? '');
+    this.ui.setPlanet(info.preset ?? '', info.seed);
     this.planetBusy = null;
     this.settledFrames = 0;
     this.writeHash(true);

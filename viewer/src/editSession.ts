@@ -125,7 +125,7 @@ export class EditSession {
     this.feed?.close();
     this.feed = null;
     this.pushState = 'off';
-    this.planet = { preset: info.preset, seed: info.seed };
+    this.planet = { ...(info.preset !== null ? { preset: info.preset } : {}), seed: info.seed };
     this.materials = [...(info.materials ?? [])];
     this.settings.material = resolveMaterial(this.materials, this.settings.material);
     this.throttle.release();

@@ -139,14 +139,14 @@ export class Ui {
     this.callbacks.onPlanet(this.preset.value, seed);
   }
 
-  setPresets(presets: PresetInfo[], current: string): void {
-    const names = presets.map((p) => p.name).join('\n');
+  setPresets(presets: (PresetInfo & { label?: string })[], current: string): void {
+    const names = presets.map((p) => `${p.name}=${p.label ?? ''}`).join('\n');
     if (this.preset.dataset['names'] !== names) {
       this.preset.replaceChildren(
         ...presets.map((p) => {
           const o = document.createElement('option');
           o.value = p.name;
-          o.textContent = p.name;
+          o.textContent = p.label ?? p.name;
           o.title = p.description;
           return o;
         }),

@@ -1,5 +1,5 @@
-//! `pmc edit`: dig and build on a planet kept in a world file (format pmc-world version 1,
-//! docs/specs/world-sqlite-v1.md): apply a brush, undo, redo, list.
+//! `pmc edit`: dig and build on a planet kept in a world file (format pmc-world version 2,
+//! docs/specs/world-sqlite-v2.md; version 1 files open too): apply a brush, undo, redo, list.
 
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
@@ -7,7 +7,7 @@ use clap::{Args, Parser, ValueEnum};
 use pmc_edit::{BrushKind, BrushOp};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{LatLon, Layout};
-use pmc_planet::{Planet, PresetKind};
+use pmc_planet::{Interpolation, Planet, PresetKind, TerrainSpec};
 use pmc_world::{Entry, World};
 use std::io::Write;
 use std::path::PathBuf;
@@ -96,6 +96,14 @@ pub struct WorldPlanetArgs {
     #[arg(long, value_parser = parse_preset)]
     preset: Option<PresetKind>,
 
+    /// A new world on a real planet: a cube-face elevation file made by `pmc dem import`.
+    #[arg(long, value_name = "FILE.pmcdem", conflicts_with = "preset")]
+    dem: Option<PathBuf>,
+
+    /// Interpolation of a new world's --dem: bicubic or bilinear [default: bicubic].
+    #[arg(long, value_name = "METHOD", value_parser = parse_interpolation)]
+    interpolation: Option<Interpolation>,
+
     /// Seed of a new world's terrain noise [default: 7].
     #[arg(long)]
     seed: Option<u64>,
@@ -125,6 +133,10 @@ fn parse_preset(s: &str) -> Result<PresetKind, String> {
     s.parse::<PresetKind>().map_err(|e| e.to_string())
 }
 
+fn parse_interpolation(s: &str) -> Result<Interpolation, String> {
+    s.parse::<Interpolation>().map_err(|e| e.to_string())
+}
+
 /// The defaults of the shared planet options, read from their single definition.
 #[derive(Parser)]
 struct DefaultPlanet {
@@ -137,6 +149,8 @@ impl WorldPlanetArgs {
     pub(crate) fn typed(planet: &PlanetArgs, given: &dyn Fn(&str) -> bool) -> WorldPlanetArgs {
         WorldPlanetArgs {
             preset: given("preset").then_some(planet.preset),
+            dem: planet.dem.clone(),
+            interpolation: given("interpolation").then_some(planet.interpolation),
             seed: given("seed").then_some(planet.seed),
             n_c: given("n_c").then_some(planet.n_c),
             n_t: given("n_t").then_some(planet.n_t),
@@ -147,11 +161,16 @@ impl WorldPlanetArgs {
     }
 
     /// The planet of a new world: the given options, the defaults of `pmc generate` elsewhere.
-    fn for_new_world(&self) -> Result<(PresetKind, u64, Layout), CliError> {
+    fn for_new_world(&self) -> Result<(TerrainSpec, Layout), CliError> {
         let d = DefaultPlanet::parse_from(["pmc"]).planet;
-        let preset = self.preset.unwrap_or(d.preset);
-        // The preset's own layout (the earth's is true scale) where no option was typed.
-        let base = preset.default_layout(None)?;
+        let seed = self.seed.unwrap_or(d.seed);
+        let terrain = match &self.dem {
+            Some(path) => crate::planet_args::dem_terrain(path, self.interpolation.unwrap_or(d.interpolation), seed)?,
+            None => TerrainSpec::preset(self.preset.unwrap_or(d.preset), seed),
+        };
+        // The terrain's own layout (the earth's is true scale, an elevation model's is for its
+        // body's radius) where no option was typed.
+        let base = pmc_planet::default_layout(&terrain).map_err(|e| CliError::Dem(e.to_string()))?;
         let layout = Layout::new(
             self.n_c.unwrap_or(base.n_c()),
             self.n_t.unwrap_or(base.n_t()),
@@ -159,20 +178,23 @@ impl WorldPlanetArgs {
             self.l_d.unwrap_or(base.l_d()),
             self.d_c.unwrap_or(base.d_c()),
         )?;
-        Ok((preset, self.seed.unwrap_or(d.seed), layout))
+        Ok((terrain, layout))
     }
 
     /// Refuses options that disagree with the world's planet, naming each.
     pub(crate) fn check_against(&self, world: &World) -> Result<(), CliError> {
-        let (preset, seed, l) = world.planet_params();
+        let (terrain, l) = world.planet_params();
         let mut diffs = Vec::new();
         let mut cmp = |name: &str, given: Option<String>, stored: String| {
             if let Some(g) = given.filter(|g| *g != stored) {
                 diffs.push(format!("--{name} {g} (the world has {stored})"));
             }
         };
-        cmp("preset", self.preset.map(|p| p.name().to_string()), preset);
-        cmp("seed", self.seed.map(|s| s.to_string()), seed.to_string());
+        let stored_preset = terrain
+            .preset_kind()
+            .map_or("none (an elevation model)".to_string(), |k| k.name().to_string());
+        cmp("preset", self.preset.map(|p| p.name().to_string()), stored_preset);
+        cmp("seed", self.seed.map(|s| s.to_string()), terrain.seed().to_string());
         cmp("n-c", self.n_c.map(|v| v.to_string()), l.n_c().to_string());
         cmp("n-t", self.n_t.map(|v| v.to_string()), l.n_t().to_string());
         // Compared as numbers, printed exactly.
@@ -180,6 +202,29 @@ impl WorldPlanetArgs {
         cmp("d-b", real(self.d_b, l.d_b()), format!("{:?}", l.d_b()));
         cmp("l-d", real(self.l_d, l.l_d()), format!("{:?}", l.l_d()));
         cmp("d-c", self.d_c.map(|v| v.to_string()), l.d_c().to_string());
+        if let (Some(i), TerrainSpec::Dem(a)) = (self.interpolation, &terrain) {
+            cmp(
+                "interpolation",
+                Some(i.name().to_string()),
+                a.interpolation.name().to_string(),
+            );
+        }
+        if let Some(path) = &self.dem {
+            let given = crate::planet_args::dem_terrain(path, Interpolation::default(), 0)?;
+            match (&terrain, &given) {
+                (TerrainSpec::Dem(a), TerrainSpec::Dem(b)) if a.digest == b.digest => {}
+                (TerrainSpec::Dem(a), _) => diffs.push(format!(
+                    "--dem {} (the world was made from another elevation file, {})",
+                    path.display(),
+                    a.path
+                )),
+                _ => diffs.push(format!(
+                    "--dem {} (the world's planet is the preset {})",
+                    path.display(),
+                    terrain.name()
+                )),
+            }
+        }
         if diffs.is_empty() {
             return Ok(());
         }
@@ -264,8 +309,8 @@ fn material(planet: &Planet, given: &str) -> Result<u8, CliError> {
     id.and_then(|i| u8::try_from(i).ok()).ok_or_else(|| {
         let list: Vec<String> = names.iter().enumerate().map(|(i, n)| format!("{n} ({i})")).collect();
         CliError::Edit(format!(
-            "unknown material '{given}' for preset {}; choose one of: {}",
-            planet.terrain().kind,
+            "unknown material '{given}' for {}; choose one of: {}",
+            planet.terrain().spec.name(),
             list.join(", ")
         ))
     })
@@ -279,7 +324,7 @@ fn brush_kind(planet: &Planet, brush: BrushName, mat: Option<&str>) -> Result<Br
         }),
         (BrushName::Paint, None) => Err(CliError::Edit(format!(
             "paint needs --material NAME|ID; the materials of {} are: {}",
-            planet.terrain().kind,
+            planet.terrain().spec.name(),
             planet.terrain().materials.join(", ")
         ))),
         (_, Some(_)) => Err(CliError::Edit("--material applies to paint only".into())),
@@ -292,17 +337,13 @@ fn brush_kind(planet: &Planet, brush: BrushName, mat: Option<&str>) -> Result<Br
 
 /// The planet of a world file, with its active edits.
 pub(crate) fn planet_of(world: &World) -> Result<Planet, CliError> {
-    let (preset, seed, layout) = world.planet_params();
-    let kind = preset.parse::<PresetKind>().map_err(|_| {
-        CliError::Edit(format!(
-            "{} uses the preset '{preset}', which this pmc does not know; upgrade pmc",
-            world.path().display()
-        ))
-    })?;
+    let (terrain, layout) = world.planet_params();
+    let planet = Planet::from_terrain(&terrain, layout)
+        .map_err(|e| CliError::Dem(format!("{}: {e}", world.path().display())))?;
     // The world's edits are part of the planet: a brush placed "on the surface" lands on the
     // edited ground (digging twice in one place goes deeper).
     let edits = world.active_edits()?;
-    Ok(Planet::new(kind, seed, layout).with_edits(edits.into()))
+    Ok(planet.with_edits(edits.into()))
 }
 
 /// Runs `pmc edit`.
@@ -352,8 +393,11 @@ pub fn run(args: &EditArgs) -> Result<(), CliError> {
         let planet = planet_of(&world)?;
         (Some(world), planet)
     } else {
-        let (preset, seed, layout) = args.planet.for_new_world()?;
-        (None, Planet::new(preset, seed, layout))
+        let (terrain, layout) = args.planet.for_new_world()?;
+        (
+            None,
+            Planet::from_terrain(&terrain, layout).map_err(|e| CliError::Dem(e.to_string()))?,
+        )
     };
     let kind = brush_kind(&planet, brush, args.material.as_deref())?;
     let first = BrushOp::new(kind, center(&planet, at, 0)?, radius, strength)?;
@@ -362,13 +406,13 @@ pub fn run(args: &EditArgs) -> Result<(), CliError> {
         None => {
             let t = planet.terrain();
             let l = planet.layout();
-            let (w, created) = World::open_or_create(&args.world, t.kind.name(), t.seed, l)?;
+            let (w, created) = World::open_or_create(&args.world, &t.spec, l)?;
             if created {
                 eprintln!(
-                    "created world {} (preset {}, seed {}, n_c {}, n_t {}, d_b {} m, l_d {} m, d_c {})",
+                    "created world {} ({}, seed {}, n_c {}, n_t {}, d_b {} m, l_d {} m, d_c {})",
                     args.world.display(),
-                    t.kind,
-                    t.seed,
+                    t.spec.name(),
+                    t.spec.seed(),
                     l.n_c(),
                     l.n_t(),
                     l.d_b(),
@@ -458,7 +502,8 @@ fn list(world: &World, json: bool) -> Result<(), CliError> {
         };
         (ll, e.op.center.length() - datum, material)
     };
-    let (preset, seed, l) = world.planet_params();
+    let (terrain, l) = world.planet_params();
+    let (name, seed) = (terrain.name(), terrain.seed());
     let mut out = std::io::stdout().lock();
     let text = if json {
         let edits: Vec<serde_json::Value> = entries
@@ -481,7 +526,8 @@ fn list(world: &World, json: bool) -> Result<(), CliError> {
             .collect();
         let v = serde_json::json!({
             "world": world.path().display().to_string(),
-            "preset": preset,
+            "preset": terrain.preset_kind().map(|k| k.name()),
+            "terrain": terrain.to_string(),
             "seed": seed,
             "layout": { "n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c() },
             "edits": edits,
@@ -490,7 +536,7 @@ fn list(world: &World, json: bool) -> Result<(), CliError> {
         serde_json::to_string_pretty(&v).unwrap_or_default() + "\n"
     } else {
         let mut s = format!(
-            "world {}: preset {preset}, seed {seed}, n_c {}, n_t {}, d_b {} m, l_d {} m, d_c {}\n",
+            "world {}: {name}, seed {seed}, n_c {}, n_t {}, d_b {} m, l_d {} m, d_c {}\n",
             world.path().display(),
             l.n_c(),
             l.n_t(),

@@ -50,6 +50,10 @@ pub enum CliError {
     /// A brush operation was refused (centre, radius or strength).
     #[error("{0}")]
     Brush(#[from] pmc_edit::BrushError),
+    /// An elevation model could not be imported, opened or used (the message names the file and
+    /// the problem).
+    #[error("{0}")]
+    Dem(String),
     /// Invalid `pmc edit` options, or planet options that disagree with the world file.
     #[error("{0}")]
     Edit(String),
@@ -82,7 +86,7 @@ impl CliError {
             CliError::Render(_) => 2,
             CliError::Export(_) | CliError::Threads { .. } => 1,
             CliError::World(pmc_world::WorldError::Io { .. } | pmc_world::WorldError::Sqlite { .. }) => 1,
-            CliError::World(_) | CliError::Brush(_) | CliError::Edit(_) => 2,
+            CliError::World(_) | CliError::Brush(_) | CliError::Edit(_) | CliError::Dem(_) => 2,
         }
     }
 }

@@ -48,10 +48,11 @@ pub fn run(args: &FlightArgs) -> Result<(), CliError> {
     if !(args.pixels.is_finite() && args.pixels > 0.0) {
         return Err(CliError::Edit(format!("--pixels must be above 0, got {}", args.pixels)));
     }
-    let layout = args.planet.layout()?;
+    let terrain = args.planet.terrain()?;
+    let layout = args.planet.layout_for(&terrain)?;
+    let name = terrain.name();
     let config = ServerConfig {
-        preset: args.planet.preset,
-        seed: args.planet.seed,
+        terrain,
         layout,
         threads: args.threads,
         ..ServerConfig::default()
@@ -107,7 +108,7 @@ pub fn run(args: &FlightArgs) -> Result<(), CliError> {
     } else {
         println!(
             "{} seed {} (radius {:.0} m) at {lat}, {lon}; {} px, 1920x1080, 60 deg",
-            args.planet.preset, args.planet.seed, radius, args.pixels
+            name, args.planet.seed, radius, args.pixels
         );
         for (name, reports) in &all {
             println!("\n{name}:");

@@ -88,7 +88,7 @@ fn check_output(path: &Path) -> Result<(), CliError> {
 pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     let planet = match &args.world {
         Some(path) => crate::edit::planet_of(&pmc_world::World::open(path)?)?,
-        None => pmc_planet::Planet::new(args.planet.preset, args.planet.seed, args.planet.layout()?),
+        None => args.planet.planet()?,
     };
     let layout = *planet.layout();
     let region = match &args.region {
@@ -136,8 +136,8 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     let meshed = start.elapsed();
     let t = planet.terrain();
     let meta = ExportMeta {
-        preset: t.kind.name().to_string(),
-        seed: t.seed,
+        preset: t.spec.preset_kind().map_or("dem", |k| k.name()).to_string(),
+        seed: t.spec.seed(),
         n_c: layout.n_c(),
         n_t: layout.n_t(),
         d_b: layout.d_b(),
@@ -159,10 +159,10 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     spinner.finish_and_clear();
     if !args.quiet {
         eprintln!(
-            "{} preset {} seed {}: {} chunks with surface of {}, {} triangles, {} vertices, meshed in {:.2} s; wrote {} ({:.1} MB) in {:.2} s",
+            "{} {} seed {}: {} chunks with surface of {}, {} triangles, {} vertices, meshed in {:.2} s; wrote {} ({:.1} MB) in {:.2} s",
             if stats.meshes > 0 { "planet" } else { "empty planet" },
-            t.kind,
-            t.seed,
+            t.spec.name(),
+            t.spec.seed(),
             meshes.len(),
             total,
             stats.triangles,

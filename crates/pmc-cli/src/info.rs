@@ -31,8 +31,9 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     let levels: Vec<Level> = (0..=l.max_level()).map(|level| Level::of(l, level)).collect();
     if args.json {
         let v = serde_json::json!({
-            "preset": t.kind.name(),
-            "seed": t.seed,
+            "preset": t.spec.preset_kind().map(|k| k.name()),
+            "terrain": t.spec.to_string(),
+            "seed": t.spec.seed(),
             "layout": { "n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c() },
             "chunks": l.chunk_count(),
             "voxels": l.voxel_count(),
@@ -61,10 +62,12 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "planet       preset {} ({}), seed {}",
-        t.kind,
-        t.kind.description(),
-        t.seed
+        "planet       {} ({}), seed {}",
+        t.spec.name(),
+        t.spec
+            .preset_kind()
+            .map_or("an elevation model, detail noise and caves", |k| k.description()),
+        t.spec.seed()
     );
     println!(
         "layout       n_c = {}, n_t = {}, d_b = {} m, l_d = {} m, d_c = {}",

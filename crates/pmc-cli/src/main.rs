@@ -1,6 +1,7 @@
 //! `pmc`: planetary marching cubes from the command line.
 #![forbid(unsafe_code)]
 
+mod dem;
 mod edit;
 mod error;
 mod flight;
@@ -40,6 +41,9 @@ enum Command {
     /// Measure a viewer's flight through an in-process server: a cold teleport to 2 m above
     /// the ground, then a descent from orbit (time to converge, triangles, memory per stop).
     BenchFlight(flight::FlightArgs),
+    /// Real planets: import elevation models (netCDF, GeoTIFF, 16-bit PNG) onto the cube faces,
+    /// describe the files, probe the surface at a place.
+    Dem(dem::DemArgs),
 }
 
 fn main() -> ExitCode {
@@ -65,6 +69,7 @@ fn main() -> ExitCode {
         Command::Edit(a) => edit::run(a),
         Command::Path(a) => path::run(a),
         Command::BenchFlight(a) => flight::run(a),
+        Command::Dem(a) => dem::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

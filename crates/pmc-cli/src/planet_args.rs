@@ -10,7 +10,7 @@ use crate::error::CliError;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, Command, FromArgMatches};
 use pmc_geometry::Layout;
-use pmc_planet::{Planet, PresetKind};
+use pmc_planet::{DemSpec, Interpolation, Planet, PresetKind, TerrainSpec};
 
 /// The ids of the five layout options, in the order of [`Layout::new`]'s parameters.
 const LAYOUT_IDS: [&str; 5] = ["n_c", "n_t", "d_b", "l_d", "d_c"];
@@ -24,6 +24,17 @@ struct PlanetOptions {
     /// on its own layout unless layout options are given).
     #[arg(long, default_value = "earthlike", value_parser = parse_preset)]
     preset: PresetKind,
+
+    /// A real planet instead of a preset: a cube-face elevation file made by `pmc dem import`
+    /// (the body's radius gives the layout; detail noise below the data's resolution and caves
+    /// under its land come from --seed).
+    #[arg(long, value_name = "FILE.pmcdem", conflicts_with = "preset")]
+    dem: Option<std::path::PathBuf>,
+
+    /// How heights of --dem are interpolated between samples: bicubic or bilinear (both exact at
+    /// the samples).
+    #[arg(long, value_name = "METHOD", default_value = "bicubic", value_parser = parse_interpolation)]
+    interpolation: Interpolation,
 
     /// Seed for the terrain noise: the same seed and parameters give byte-identical output.
     #[arg(long, default_value_t = 7)]
@@ -79,6 +90,10 @@ fn parse_preset(s: &str) -> Result<PresetKind, String> {
     s.parse::<PresetKind>().map_err(|e| e.to_string())
 }
 
+fn parse_interpolation(s: &str) -> Result<Interpolation, String> {
+    s.parse::<Interpolation>().map_err(|e| e.to_string())
+}
+
 /// Preset, seed and layout (`--radius`, or the parameters of seed 000 Sec. 4.3 under the
 /// paper's names). The layout fields hold what was typed, or the default planet's value when
 /// nothing was; [`PlanetArgs::layout`] resolves them against the preset's layout.
@@ -86,6 +101,10 @@ fn parse_preset(s: &str) -> Result<PresetKind, String> {
 pub struct PlanetArgs {
     /// Terrain preset.
     pub preset: PresetKind,
+    /// The elevation file, if `--dem` was given (it replaces the preset).
+    pub dem: Option<std::path::PathBuf>,
+    /// Interpolation of `--dem`.
+    pub interpolation: Interpolation,
     /// Noise seed.
     pub seed: u64,
     /// Planet radius in metres, if `--radius` was given.
@@ -110,6 +129,8 @@ impl FromArgMatches for PlanetArgs {
         let typed = LAYOUT_IDS.map(|id| matches.value_source(id) == Some(ValueSource::CommandLine));
         Ok(PlanetArgs {
             preset: o.preset,
+            dem: o.dem,
+            interpolation: o.interpolation,
             seed: o.seed,
             radius: o.radius,
             n_c: o.n_c,
@@ -140,13 +161,28 @@ impl Args for PlanetArgs {
 }
 
 impl PlanetArgs {
-    /// The validated layout: the preset's layout for `--radius`, or the preset's own layout with
-    /// each typed layout option replacing its parameter.
-    pub fn layout(&self) -> Result<Layout, CliError> {
+    /// The terrain: the preset and seed, or the `--dem` file (opened to read its digest; the
+    /// path is kept absolute, so a world made from it opens from any directory).
+    pub fn terrain(&self) -> Result<TerrainSpec, CliError> {
+        match &self.dem {
+            None => Ok(TerrainSpec::preset(self.preset, self.seed)),
+            Some(path) => dem_terrain(path, self.interpolation, self.seed),
+        }
+    }
+
+    /// The validated layout for `terrain` (from [`PlanetArgs::terrain`]): the preset's layout
+    /// for `--radius`, or the terrain's own layout (the preset's, or the one for an elevation
+    /// model's body radius) with each typed layout option replacing its parameter.
+    pub fn layout_for(&self, terrain: &TerrainSpec) -> Result<Layout, CliError> {
         if let Some(r) = self.radius {
+            if self.dem.is_some() {
+                return Err(CliError::Dem(
+                    "--radius does not apply to --dem: the elevation file gives the body's radius".into(),
+                ));
+            }
             return Ok(self.preset.default_layout(Some(r))?);
         }
-        let base = self.preset.default_layout(None)?;
+        let base = pmc_planet::default_layout(terrain).map_err(|e| CliError::Dem(e.to_string()))?;
         let pick = |i: usize| self.typed[i];
         Ok(Layout::new(
             if pick(0) { self.n_c } else { base.n_c() },
@@ -159,8 +195,33 @@ impl PlanetArgs {
 
     /// Builds the planet.
     pub fn planet(&self) -> Result<Planet, CliError> {
-        Ok(Planet::new(self.preset, self.seed, self.layout()?))
+        let terrain = self.terrain()?;
+        let layout = self.layout_for(&terrain)?;
+        Planet::from_terrain(&terrain, layout).map_err(|e| CliError::Dem(e.to_string()))
     }
+}
+
+/// The terrain of the elevation file at `path`: its digest read from the file, the path made
+/// absolute.
+pub(crate) fn dem_terrain(
+    path: &std::path::Path,
+    interpolation: Interpolation,
+    seed: u64,
+) -> Result<TerrainSpec, CliError> {
+    let dem = pmc_dem::CubeDem::open(path).map_err(|e| CliError::Dem(e.to_string()))?;
+    let abs = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let text = abs.to_str().ok_or_else(|| {
+        CliError::Dem(format!(
+            "{}: the path is not valid UTF-8; rename the file",
+            path.display()
+        ))
+    })?;
+    Ok(TerrainSpec::Dem(DemSpec {
+        path: text.to_string(),
+        digest: dem.digest().to_string(),
+        interpolation,
+        seed,
+    }))
 }
 
 #[cfg(test)]
@@ -176,7 +237,8 @@ mod tests {
 
     fn layout(args: &[&str]) -> Result<Layout, String> {
         let cli = Cli::try_parse_from(std::iter::once("pmc").chain(args.iter().copied())).map_err(|e| e.to_string())?;
-        cli.planet.layout().map_err(|e| e.to_string())
+        let p = &cli.planet;
+        p.terrain().and_then(|t| p.layout_for(&t)).map_err(|e| e.to_string())
     }
 
     #[test]

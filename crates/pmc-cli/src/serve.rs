@@ -65,7 +65,8 @@ fn parse_host(s: &str) -> Result<IpAddr, CliError> {
 
 /// Runs `pmc serve` until Ctrl-C or SIGTERM. `given` tells which planet options were typed.
 pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliError> {
-    let layout = args.planet.layout()?;
+    let terrain = args.planet.terrain()?;
+    let layout = args.planet.layout_for(&terrain)?;
     let host = parse_host(&args.host)?;
     if let Some(path) = args.world.as_deref().filter(|p| std::fs::symlink_metadata(p).is_ok()) {
         // An existing world keeps its planet: typed options that disagree are a mistake.
@@ -76,8 +77,7 @@ pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliErro
     let config = ServerConfig {
         host,
         port: args.port,
-        preset: args.planet.preset,
-        seed: args.planet.seed,
+        terrain,
         layout,
         cache_bytes: args.cache_mb.saturating_mul(1 << 20),
         threads: args.threads,

@@ -88,6 +88,7 @@ mod error;
 mod header;
 mod read;
 mod source;
+mod terrain;
 
 mod netcdf_source;
 pub use netcdf_source::NetcdfSource;
@@ -98,8 +99,11 @@ pub use png16::PngExtent;
 pub mod fuzz;
 
 pub use cube::{import_cube, CubeDem, DetailNoise, ImportOptions, ImportReport, Interpolation};
+pub use cube::{FormatChoice, StorageRow, DEFAULT_RADIUS};
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
 pub use header::MAX_HEADER_BYTES;
+pub use pmc_density::terrain::HeightField;
 pub use read::MAX_CELLS;
 pub use source::EquirectSource;
+pub use terrain::{dem_heights, dem_layout, dem_terrain, nearest_sample, DemHeights, DemTerrainError, NearestSample};

@@ -126,7 +126,12 @@ pub fn dem_terrain(spec: &DemSpec, layout: &Layout) -> Result<Terrain, DemTerrai
         });
     }
     let (heights, vertical) = dem_heights(dem, spec, layout);
-    Ok(heightfield_terrain(Arc::new(heights), TerrainSpec::Dem(spec.clone()), layout, vertical)?)
+    Ok(heightfield_terrain(
+        Arc::new(heights),
+        TerrainSpec::Dem(spec.clone()),
+        layout,
+        vertical,
+    )?)
 }
 
 /// The heights a planet of `spec` on `layout` uses (in the body's metres) and the vertical scale

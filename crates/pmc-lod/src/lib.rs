@@ -94,6 +94,7 @@ mod adjacency;
 pub mod bounds;
 mod cull;
 mod errors;
+pub mod probe;
 #[cfg(test)]
 mod reference;
 mod region;

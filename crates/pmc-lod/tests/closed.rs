@@ -51,7 +51,7 @@ fn mesh_selection(planet: &Planet, eye: DVec3, max_pixel_error: f64) -> (Vec<Chu
 fn check(planet: &Planet, eye: DVec3, max_pixel_error: f64) -> Result<Vec<usize>, TestCaseError> {
     let (meshes, histogram) = mesh_selection(planet, eye, max_pixel_error);
     let report = WeldedMesh::weld(&meshes).report();
-    let what = format!("{:?} eye {eye:?} levels {histogram:?}", planet.terrain().kind);
+    let what = format!("{:?} eye {eye:?} levels {histogram:?}", planet.terrain().spec);
     prop_assert!(report.is_closed_manifold(), "{what}: {report:?}");
     let mut normals: HashMap<EdgeKey, [f32; 3]> = HashMap::new();
     for m in &meshes {
@@ -93,7 +93,7 @@ fn views_from_the_ground_up_mix_levels_and_close() {
                 most = most.max(histogram.iter().filter(|n| **n > 0).count());
             }
         }
-        assert!(most >= 2, "{:?}: at most {most} levels", planet.terrain().kind);
+        assert!(most >= 2, "{:?}: at most {most} levels", planet.terrain().spec);
         overall = overall.max(most);
     }
     assert!(overall >= 3, "no view mixed three levels");

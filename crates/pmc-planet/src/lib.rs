@@ -23,8 +23,11 @@
 
 mod cache;
 mod planet;
+mod terrain;
 
 pub use cache::BaseCacheStats;
 pub use planet::{ChunkScratch, Planet};
 pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};
+pub use pmc_density::terrain::{DemSpec, Interpolation, TerrainSpec};
 pub use pmc_edit;
+pub use terrain::{build_terrain, default_layout, TerrainError};

@@ -1,7 +1,9 @@
 //! The planet instance and its chunk pipeline.
 
 use crate::cache::{BaseCache, BaseCacheStats};
+use crate::terrain::{build_terrain, TerrainError};
 use pmc_density::presets::{self, PresetKind, Terrain};
+use pmc_density::terrain::TerrainSpec;
 use pmc_density::Density;
 use pmc_edit::{affected_chunks, paint_at, BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
@@ -133,9 +135,21 @@ enum Known {
 }
 
 impl Planet {
-    /// Builds the terrain of `preset` with `seed` on `layout`.
+    /// Builds the terrain of `preset` with `seed` on `layout` (the same as
+    /// [`Planet::from_terrain`] with [`TerrainSpec::Preset`], which cannot fail).
     pub fn new(preset: PresetKind, seed: u64, layout: Layout) -> Planet {
-        let terrain = presets::build(preset, seed, &layout);
+        Planet::with_terrain(presets::build(preset, seed, &layout), layout)
+    }
+
+    /// Builds the terrain `spec` describes on `layout`: a preset, or an elevation model (opened
+    /// and checked against the spec's digest; see [`build_terrain`](crate::build_terrain)).
+    /// [`default_layout`](crate::default_layout) gives the layout a terrain is made for.
+    pub fn from_terrain(spec: &TerrainSpec, layout: Layout) -> Result<Planet, TerrainError> {
+        Ok(Planet::with_terrain(build_terrain(spec, &layout)?, layout))
+    }
+
+    /// A planet of `terrain` (built for `layout`) on `layout`, with no edits.
+    pub fn with_terrain(terrain: Terrain, layout: Layout) -> Planet {
         let density = terrain.density.clone();
         Planet {
             layout,

@@ -11,7 +11,7 @@ use pmc_density::Density;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Face, SideMask};
 use pmc_lod::bounds::{chunks_near, TooManyChunks};
-use pmc_planet::PresetKind;
+use pmc_planet::{PresetKind, TerrainSpec};
 use serde_json::{json, Value};
 
 /// Default and largest `limit` of `/chunks`.
@@ -167,17 +167,15 @@ impl Params {
         }
     }
 
-    /// The planet the request names (or the server's).
+    /// The planet the request names (or the server's): `preset` switches to a preset, `seed`
+    /// changes the seed (of the preset, or of an elevation model's detail and caves).
     pub(crate) fn planet(&self, state: &AppState) -> Result<PlanetId, ApiError> {
         let c = state.config();
-        let preset = match self.get("preset") {
-            None => c.preset,
-            Some(p) => p
-                .parse::<PresetKind>()
-                .map_err(|e| ApiError::bad_request(e.to_string()))?,
-        };
+        if self.get("preset").is_none() && self.get("seed").is_none() {
+            return Ok(std::sync::Arc::new(c.terrain.clone()));
+        }
         let seed = match self.get("seed") {
-            None => c.seed,
+            None => c.terrain.seed(),
             Some(s) => s.trim().parse::<u64>().map_err(|_| {
                 ApiError::bad_request(format!(
                     "seed must be a decimal integer from 0 to {}, got '{s}'",
@@ -185,7 +183,16 @@ impl Params {
                 ))
             })?,
         };
-        Ok((preset, seed))
+        let terrain = match (self.get("preset"), &c.terrain) {
+            (Some(p), _) => TerrainSpec::preset(
+                p.parse::<PresetKind>()
+                    .map_err(|e| ApiError::bad_request(e.to_string()))?,
+                seed,
+            ),
+            (None, TerrainSpec::Preset { kind, .. }) => TerrainSpec::preset(*kind, seed),
+            (None, TerrainSpec::Dem(d)) => TerrainSpec::Dem(pmc_planet::DemSpec { seed, ..d.clone() }),
+        };
+        Ok(std::sync::Arc::new(terrain))
     }
 }
 
@@ -202,8 +209,8 @@ pub async fn health() -> Response {
 pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Result<Response, ApiError> {
     let params = Params::parse(q);
     let id = params.planet(&state)?;
-    let planet = planet_of(&state, id).await?;
-    let errors = state.lod_errors(id, planet.clone()).await;
+    let planet = planet_of(&state, id.clone()).await?;
+    let errors = state.lod_errors(id.clone(), planet.clone()).await;
     let l = planet.layout();
     let t = planet.terrain();
     let lod = json!({
@@ -232,8 +239,9 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
     let v = json!({
         "format": "pmc-planet",
         "version": 1,
-        "preset": t.kind.name(),
-        "seed": t.seed.to_string(),
+        "preset": t.spec.preset_kind().map(|k| k.name()),
+        "terrain": terrain_json(&t.spec),
+        "seed": t.spec.seed().to_string(),
         "presets": presets,
         "layout": { "n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c() },
         "radius": l.radius(),
@@ -407,5 +415,24 @@ pub async fn method_not_allowed(uri: Uri) -> ApiError {
     ApiError {
         status: StatusCode::METHOD_NOT_ALLOWED,
         message: format!("{} takes {allowed} only", uri.path()),
+    }
+}
+
+/// A terrain in the planet description: its kind, name and, for an elevation model, its file.
+fn terrain_json(spec: &TerrainSpec) -> Value {
+    match spec {
+        TerrainSpec::Preset { kind, seed } => json!({
+            "kind": "preset",
+            "name": kind.name(),
+            "seed": seed.to_string(),
+        }),
+        TerrainSpec::Dem(d) => json!({
+            "kind": "dem",
+            "name": spec.name(),
+            "file": d.path.rsplit(['/', '\\']).next().unwrap_or(&d.path),
+            "digest": d.digest,
+            "interpolation": d.interpolation.name(),
+            "seed": d.seed.to_string(),
+        }),
     }
 }

@@ -2,7 +2,7 @@
 
 use crate::ServerError;
 use pmc_geometry::Layout;
-use pmc_planet::PresetKind;
+use pmc_planet::{PresetKind, TerrainSpec};
 use std::net::{IpAddr, Ipv4Addr};
 use std::path::PathBuf;
 
@@ -40,24 +40,23 @@ pub struct ServerConfig {
     pub host: IpAddr,
     /// Port to listen on; 0 picks a free one (see [`Server::local_addr`](crate::Server::local_addr)).
     pub port: u16,
-    /// The preset of the planet served when a request names none.
-    pub preset: PresetKind,
-    /// The seed of the planet served when a request names none.
-    pub seed: u64,
+    /// The terrain of the planet served when a request names none: a preset and a seed, or an
+    /// elevation model.
+    pub terrain: TerrainSpec,
     /// The layout of every planet served (fixed for the server's life).
     pub layout: Layout,
     /// Most bytes of encoded chunks kept in the cache (default 512 MiB).
     pub cache_bytes: u64,
-    /// Most planets (preset and seed pairs) kept at once, with their cached chunks (default 4).
+    /// Most planets (terrains) kept at once, with their cached chunks (default 4).
     pub max_planets: usize,
     /// Most chunk jobs waiting for a worker; a request that would add one more is answered 503
     /// (default 256).
     pub queue_limit: usize,
     /// Worker threads that generate chunks; 0 uses every core.
     pub threads: usize,
-    /// The world file to serve and edit (created when missing, with `preset`, `seed` and
-    /// `layout`). With a world, its planet is the server's default planet: an existing world's
-    /// preset, seed and layout replace those above. `None`: no editing.
+    /// The world file to serve and edit (created when missing, with `terrain` and `layout`).
+    /// With a world, its planet is the server's default planet: an existing world's terrain and
+    /// layout replace those above. `None`: no editing.
     pub world: Option<PathBuf>,
     /// Limits on edits (with a world).
     pub edit_limits: EditLimits,
@@ -71,8 +70,7 @@ impl Default for ServerConfig {
         ServerConfig {
             host: IpAddr::V4(Ipv4Addr::LOCALHOST),
             port: 8080,
-            preset: PresetKind::Earthlike,
-            seed: 7,
+            terrain: TerrainSpec::preset(PresetKind::Earthlike, 7),
             layout: Layout::default(),
             cache_bytes: 512 << 20,
             max_planets: 4,

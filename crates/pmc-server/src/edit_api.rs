@@ -41,8 +41,9 @@ pub(crate) fn edit_info(state: &AppState, id: PlanetId) -> Value {
         return json!({
             "enabled": false,
             "reason": format!(
-                "only the world's planet ({} seed {}) can be edited; this one is shown unedited",
-                editing.id.0, editing.id.1
+                "only the world's planet ({}, seed {}) can be edited; this one is shown unedited",
+                editing.id.name(),
+                editing.id.seed()
             ),
             "brushes": BRUSHES,
         });
@@ -76,8 +77,11 @@ fn editing_for(state: &AppState, query: Option<String>) -> Result<Arc<Editing>, 
         return Err(ApiError {
             status: StatusCode::CONFLICT,
             message: format!(
-                "only the world's planet ({} seed {}) can be edited, not {} seed {}",
-                editing.id.0, editing.id.1, id.0, id.1
+                "only the world's planet ({}, seed {}) can be edited, not {}, seed {}",
+                editing.id.name(),
+                editing.id.seed(),
+                id.name(),
+                id.seed()
             ),
         });
     }

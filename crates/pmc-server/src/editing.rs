@@ -13,7 +13,7 @@ use pmc_edit::{affected_chunks_lod, BrushOp, EditSnapshot};
 use pmc_geometry::ChunkKey;
 use pmc_geometry::SideMask;
 use pmc_nav::NavGrid;
-use pmc_planet::{Planet, PresetKind};
+use pmc_planet::{Planet, TerrainSpec};
 use pmc_world::{Entry, World, WorldError};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, RwLock};
@@ -141,28 +141,23 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 }
 
 impl Editing {
-    /// Opens the world at `path`, creating it for `preset`, `seed`, `layout` when missing, and
+    /// Opens the world at `path`, creating it for `terrain` and `layout` when missing, and
     /// builds its planet with the active edits. Returns the editing state and whether the file
     /// was created.
     pub fn open(
         path: &Path,
-        preset: PresetKind,
-        seed: u64,
+        terrain: &TerrainSpec,
         layout: &pmc_geometry::Layout,
         limits: EditLimits,
         base_cache_chunks: usize,
     ) -> Result<(Editing, bool), ServerError> {
-        let (world, created) = World::open_or_create(path, preset.name(), seed, layout)?;
-        let (name, seed, layout) = world.planet_params();
-        let preset = name.parse::<PresetKind>().map_err(|_| {
-            ServerError::Config(format!(
-                "{} uses the preset '{name}', which this pmc does not know; upgrade pmc",
-                path.display()
-            ))
-        })?;
+        let (world, created) = World::open_or_create(path, terrain, layout)?;
+        let (terrain, layout) = world.planet_params();
         let entries = world.entries()?;
         let data_version = world.data_version()?;
-        let base = Planet::new(preset, seed, layout).with_base_cache(base_cache_chunks);
+        let base = Planet::from_terrain(&terrain, layout)
+            .map_err(|e| ServerError::Config(format!("{}: {e}", path.display())))?
+            .with_base_cache(base_cache_chunks);
         let editor = Editor {
             world,
             entries,
@@ -179,7 +174,7 @@ impl Editing {
         Ok((
             Editing {
                 path: path.to_path_buf(),
-                id: (preset, seed),
+                id: Arc::new(terrain),
                 base,
                 editor: Mutex::new(editor),
                 current: RwLock::new(current),
@@ -320,7 +315,7 @@ impl Editing {
                         // Every seam variant of the chunk: the submasks of its seam sides.
                         let sides = layout.seam_sides(key).0;
                         (0..=sides).filter(move |m| m & !sides == 0).map(move |m| ChunkId {
-                            planet: self.id,
+                            planet: self.id.clone(),
                             key: *key,
                             seams: SideMask(m),
                         })
@@ -328,7 +323,7 @@ impl Editing {
                     current.revision,
                 )
             }
-            None => generator.invalidate_planet(self.id, current.revision),
+            None => generator.invalidate_planet(self.id.clone(), current.revision),
         }
         current
     }

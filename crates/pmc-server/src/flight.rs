@@ -133,7 +133,7 @@ pub fn peak_rss() -> Option<u64> {
 /// Flies through `stops` on the server's default planet, one after the other without clearing
 /// the cache (as a user flying down would), and measures each.
 pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Result<Vec<StopReport>, FlightError> {
-    let id = (state.config().preset, state.config().seed);
+    let id = std::sync::Arc::new(state.config().terrain.clone());
     let planet = state.default_planet().await.map_err(|reason| FlightError::Decode {
         path: "/api/v1/planet".into(),
         reason,

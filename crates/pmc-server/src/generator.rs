@@ -12,7 +12,7 @@ use axum::body::Bytes;
 use pmc_formats::chunk_encoding::encode_chunk;
 use pmc_geometry::{ChunkKey, SideMask};
 use pmc_mesh::ChunkMesh;
-use pmc_planet::{ChunkScratch, Planet, PresetKind};
+use pmc_planet::{ChunkScratch, Planet, TerrainSpec};
 use std::cell::RefCell;
 use std::cmp::Ordering;
 use std::collections::{BTreeMap, HashMap};
@@ -20,11 +20,12 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use tokio::sync::watch;
 
 /// A planet's identity: preset and seed (the layout is the server's).
-pub(crate) type PlanetId = (PresetKind, u64);
+/// A planet's identity: its terrain (every planet a server holds shares its layout).
+pub(crate) type PlanetId = std::sync::Arc<TerrainSpec>;
 
 /// A chunk of a planet. The key carries the level of detail, so the chunks of every level are
 /// distinct entries of the cache and distinct jobs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct ChunkId {
     pub planet: PlanetId,
     pub key: ChunkKey,
@@ -275,7 +276,7 @@ impl Generator {
                     store.jobs.insert(
                         token,
                         Job {
-                            id,
+                            id: id.clone(),
                             rx: rx.clone(),
                             waiters: 1,
                             state: JobState::Queued { rank, planet, tx },
@@ -319,7 +320,7 @@ impl Generator {
             JobState::Queued { rank, .. } => *rank,
             JobState::Running => return,
         };
-        let id = job.id;
+        let id = job.id.clone();
         store.queue.remove(&rank);
         store.jobs.remove(&token);
         store.unregister(id, token);
@@ -355,7 +356,7 @@ impl Generator {
                 JobState::Queued { planet, tx, .. } => (planet, tx),
                 JobState::Running => return,
             };
-            let id = job.id;
+            let id = job.id.clone();
             store.counts.running += 1;
             (token, id, planet, tx)
         };
@@ -375,7 +376,7 @@ impl Generator {
             if let Ok(bytes) = &result {
                 store.counts.generated += 1;
                 if store.pending.get(&id) == Some(&token) {
-                    store.cache.insert(id, bytes.clone(), bytes.len() as u64);
+                    store.cache.insert(id.clone(), bytes.clone(), bytes.len() as u64);
                 }
             }
             store.unregister(id, token);

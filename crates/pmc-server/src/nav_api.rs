@@ -93,7 +93,7 @@ pub async fn path(State(state): State<AppState>, RawQuery(q): RawQuery) -> Resul
         }
     };
     // Checked before any grid is built.
-    let (current, revision) = state.planet(id).await.map_err(ApiError::internal)?;
+    let (current, revision) = state.planet(id.clone()).await.map_err(ApiError::internal)?;
     let datum_probe = current.datum_radius();
     let (from, to) = (end(&params, "from", datum_probe)?, end(&params, "to", datum_probe)?);
     if wants_lazy_grid(current.layout()) {

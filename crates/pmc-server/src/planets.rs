@@ -38,8 +38,8 @@ impl Planets {
     }
 
     /// Builds planet `id` (the caller runs this off the async runtime).
-    pub fn build(&self, id: PlanetId) -> Planet {
-        Planet::new(id.0, id.1, self.layout)
+    pub fn build(&self, id: &PlanetId) -> Result<Planet, String> {
+        Planet::from_terrain(id, self.layout).map_err(|e| e.to_string())
     }
 
     /// Adds `planet` as `id` (keeping one already added by a concurrent request) and returns the

@@ -105,10 +105,9 @@ impl Server {
     pub async fn run(self, shutdown: impl Future<Output = ()> + Send + 'static) -> Result<(), ServerError> {
         let c = self.state.config();
         tracing::info!(
-            "PMC server listening on {}: preset {} seed {}, layout n_c={} n_t={} d_b={} l_d={} d_c={}{}",
+            "PMC server listening on {}: terrain {}, layout n_c={} n_t={} d_b={} l_d={} d_c={}{}",
             self.url(),
-            c.preset,
-            c.seed,
+            c.terrain,
             c.layout.n_c(),
             c.layout.n_t(),
             c.layout.d_b(),

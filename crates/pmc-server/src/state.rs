@@ -130,8 +130,7 @@ impl AppState {
             Some(path) => {
                 let (editing, created) = Editing::open(
                     path,
-                    config.preset,
-                    config.seed,
+                    &config.terrain,
                     &config.layout,
                     config.edit_limits,
                     config.base_cache_chunks,
@@ -144,7 +143,7 @@ impl AppState {
                     c.active,
                     c.redo
                 );
-                (config.preset, config.seed) = editing.id;
+                config.terrain = (*editing.id).clone();
                 config.layout = *editing.layout();
                 Some(Arc::new(editing))
             }
@@ -224,17 +223,17 @@ impl AppState {
     pub async fn lod_errors_of_default(&self) -> Result<Arc<Vec<f64>>, String> {
         let c = self.config();
         let planet = self.default_planet().await?;
-        Ok(self.lod_errors((c.preset, c.seed), planet).await)
+        Ok(self.lod_errors(Arc::new(c.terrain.clone()), planet).await)
     }
 
     /// The server's default planet (the world's, with its edits, when serving a world).
     pub async fn default_planet(&self) -> Result<Arc<Planet>, String> {
         let c = self.config();
-        self.planet((c.preset, c.seed)).await.map(|(p, _)| p)
+        self.planet(Arc::new(c.terrain.clone())).await.map(|(p, _)| p)
     }
 
     pub(crate) async fn planet(&self, id: PlanetId) -> Result<(Arc<Planet>, u64), String> {
-        if let Some(e) = self.editing_of(id) {
+        if let Some(e) = self.editing_of(id.clone()) {
             let c = e.current();
             return Ok((c.planet, c.revision));
         }
@@ -242,13 +241,14 @@ impl AppState {
     }
 
     async fn plain_planet(&self, id: PlanetId) -> Result<Arc<Planet>, String> {
-        if let Some(p) = self.inner.planets.get(id) {
+        if let Some(p) = self.inner.planets.get(id.clone()) {
             return Ok(p);
         }
         let this = self.clone();
-        let planet = tokio::task::spawn_blocking(move || this.inner.planets.build(id))
+        let build_id = id.clone();
+        let planet = tokio::task::spawn_blocking(move || this.inner.planets.build(&build_id))
             .await
-            .map_err(|e| format!("building the planet failed: {e}"))?;
+            .map_err(|e| format!("building the planet failed: {e}"))??;
         let (planet, dropped) = self.inner.planets.insert(id, planet);
         for old in dropped {
             self.inner.generator.forget_planet(old);
@@ -264,8 +264,11 @@ impl AppState {
         // the chunks it changed; take the new one and ask again (edits are rate-limited, so this
         // ends).
         loop {
-            let (planet, revision) = self.planet(id.planet).await.map_err(|e| ChunkError::Failed(e.into()))?;
-            match self.inner.generator.chunk(planet, revision, id, priority).await {
+            let (planet, revision) = self
+                .planet(id.planet.clone())
+                .await
+                .map_err(|e| ChunkError::Failed(e.into()))?;
+            match self.inner.generator.chunk(planet, revision, id.clone(), priority).await {
                 Err(ChunkError::Stale) => continue,
                 other => return other,
             }
@@ -281,8 +284,11 @@ impl AppState {
         agent: Agent,
     ) -> Result<(Arc<NavGrid>, Arc<Planet>, u64), crate::api::ApiError> {
         use crate::api::ApiError;
-        let (planet, revision) = self.planet(id).await.map_err(ApiError::internal)?;
-        let world = self.editing_of(id).filter(|_| agent == Agent::default()).cloned();
+        let (planet, revision) = self.planet(id.clone()).await.map_err(ApiError::internal)?;
+        let world = self
+            .editing_of(id.clone())
+            .filter(|_| agent == Agent::default())
+            .cloned();
         if let Some(g) = world.as_ref().and_then(|e| e.nav_grid(revision)) {
             return Ok((g, planet, revision));
         }

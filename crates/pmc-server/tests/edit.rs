@@ -117,13 +117,15 @@ async fn a_missing_world_is_created_and_an_existing_one_keeps_its_planet() {
     drop(a);
     // Reopened with other planet settings: the world's planet wins.
     let other = ServerConfig {
-        preset: PresetKind::Moon,
-        seed: 99,
+        terrain: pmc_planet::TerrainSpec::preset(PresetKind::Moon, 99),
         layout: Layout::new(4, 8, 100.0, 2.0, 2).unwrap(),
         ..world_config(&path)
     };
     let state = AppState::new(other).unwrap();
-    assert_eq!((state.config().preset, state.config().seed), (PresetKind::Earthlike, 3));
+    assert_eq!(
+        state.config().terrain,
+        pmc_planet::TerrainSpec::preset(PresetKind::Earthlike, 3)
+    );
     assert_eq!(state.config().layout, small_layout());
     let v = get(&router(state), "/api/v1/planet").await.json();
     assert_eq!(

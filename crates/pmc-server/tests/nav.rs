@@ -164,7 +164,7 @@ async fn a_worlds_grid_follows_its_edits() {
     std::fs::create_dir_all(&d).unwrap();
     let config = ServerConfig {
         world: Some(d.join("w.pmcw")),
-        preset: PresetKind::Sphere,
+        terrain: pmc_planet::TerrainSpec::preset(PresetKind::Sphere, small_config().terrain.seed()),
         ..small_config()
     };
     let a = router(AppState::new(config).unwrap());
@@ -217,7 +217,7 @@ async fn a_planet_too_large_for_a_grid_gets_lazy_paths_and_a_400_for_the_grid() 
     assert_eq!(v["found"], true, "{v}");
     assert_eq!(v["revision"], 0);
     assert!(v["search"]["expanded"].as_u64().unwrap() > 0, "{v}");
-    let planet = Planet::new(small_config().preset, small_config().seed, layout);
+    let planet = Planet::from_terrain(&small_config().terrain, layout).unwrap();
     let mut grid = pmc_nav::LazyGrid::new(
         planet.density().clone(),
         planet.layout(),

@@ -98,9 +98,15 @@ pub enum WorldError {
     /// `append` was given an operation that `BrushOp::new` would refuse.
     #[error("invalid edit, not stored: {0}")]
     InvalidEdit(#[from] BrushError),
-    /// `create` was given an unusable preset name.
-    #[error("invalid preset name {0:?}: give the preset's name (1 to 64 characters, no control characters)")]
-    InvalidPreset(String),
+    /// The world's planet is made of a terrain this program does not know (a preset added by a
+    /// newer version, say). Fix: upgrade pmc.
+    #[error("{}: the planet uses the terrain {terrain}, which this pmc does not know; upgrade pmc to open it (the file was left untouched)", .path.display())]
+    UnknownTerrain {
+        /// The world file.
+        path: PathBuf,
+        /// The terrain as stored.
+        terrain: String,
+    },
     /// The operating system refused a file operation.
     #[error("{}: {source}; check that the directory exists and is writable", .path.display())]
     Io {

@@ -1,4 +1,5 @@
-//! The constants and schema of format `pmc-world` version 1 (docs/specs/world-sqlite-v1.md), and
+//! The constants and schemas of format `pmc-world` versions 1 and 2 (docs/specs/world-sqlite-v2.md,
+//! docs/specs/world-sqlite-v1.md), and
 //! the recognition of a file from its first 100 bytes, before SQLite ever touches it.
 
 use crate::error::{Result, WorldError};
@@ -8,23 +9,26 @@ use std::path::Path;
 /// `PRAGMA application_id` of every PMC world: the ASCII bytes "PMCW", big-endian.
 pub const APPLICATION_ID: u32 = u32::from_be_bytes(*b"PMCW");
 
-/// `PRAGMA user_version` of this format version; also the `version` row of table `meta`.
-pub const FORMAT_VERSION: u32 = 1;
+/// `PRAGMA user_version` of the format version written; also the `version` row of table `meta`.
+pub const FORMAT_VERSION: u32 = 2;
+
+/// The oldest format version read (and edited in place, keeping its version).
+pub const OLDEST_FORMAT_VERSION: u32 = 1;
 
 /// The `format` row of table `meta`.
 pub const FORMAT_NAME: &str = "pmc-world";
 
-/// The schema of version 1, created in one transaction together with the header values.
-pub(crate) const SCHEMA_V1: &str = "
+/// The schema of version 2, created in one transaction together with the header values. Version
+/// 1 differs only in table `planet`, which held `preset` and `seed` instead of `terrain`.
+pub(crate) const SCHEMA_V2: &str = "
 CREATE TABLE meta (
     key   TEXT PRIMARY KEY NOT NULL,
     value TEXT NOT NULL
 ) WITHOUT ROWID;
 
 CREATE TABLE planet (
-    id     INTEGER PRIMARY KEY CHECK (id = 1),
-    preset TEXT NOT NULL,
-    seed   TEXT NOT NULL CHECK (seed GLOB '[0-9]*' AND seed NOT GLOB '*[^0-9]*'),
+    id      INTEGER PRIMARY KEY CHECK (id = 1),
+    terrain TEXT NOT NULL CHECK (length(terrain) BETWEEN 1 AND 4096),
     n_c    INTEGER NOT NULL CHECK (typeof(n_c) = 'integer' AND n_c >= 1),
     n_t    INTEGER NOT NULL CHECK (typeof(n_t) = 'integer' AND n_t >= 1),
     d_b    NOT NULL CHECK (typeof(d_b) = 'real'),

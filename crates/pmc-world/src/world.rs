@@ -2,7 +2,9 @@
 //! redo, every acknowledged change committed durably before the call returns.
 
 use crate::error::{sqlite, Result, WorldError};
-use crate::format::{self, APPLICATION_ID, FORMAT_NAME, FORMAT_VERSION, SCHEMA_V1};
+use crate::format::{self, APPLICATION_ID, FORMAT_NAME, FORMAT_VERSION, OLDEST_FORMAT_VERSION, SCHEMA_V2};
+use pmc_density::presets::PresetKind;
+use pmc_density::terrain::TerrainSpec;
 use pmc_edit::{BrushKind, BrushOp};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
@@ -48,37 +50,36 @@ pub struct Entry {
 pub struct World {
     conn: Connection,
     path: PathBuf,
-    preset: String,
-    seed: u64,
+    terrain: TerrainSpec,
     layout: Layout,
+    version: u32,
 }
 
 impl std::fmt::Debug for World {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("World")
             .field("path", &self.path)
-            .field("preset", &self.preset)
-            .field("seed", &self.seed)
+            .field("terrain", &self.terrain)
             .field("layout", &self.layout)
+            .field("version", &self.version)
             .finish_non_exhaustive()
     }
 }
 
 impl World {
-    /// Creates a new world file at `path` for the planet `preset`, `seed`, `layout`, with no
-    /// edits. Refuses with [`WorldError::Exists`] when anything exists at `path` (it is never
+    /// Creates a new world file (format version 2) at `path` for the planet made of `terrain` on
+    /// `layout`, with no edits. Refuses with [`WorldError::Exists`] when anything exists at `path` (it is never
     /// overwritten). The file is built under a temporary name in the same directory and linked
     /// into place only when complete, so `path` never holds a half-made world.
-    pub fn create(path: impl AsRef<Path>, preset: &str, seed: u64, layout: &Layout) -> Result<World> {
+    pub fn create(path: impl AsRef<Path>, terrain: &TerrainSpec, layout: &Layout) -> Result<World> {
         let path = path.as_ref();
-        check_preset(preset)?;
         if std::fs::symlink_metadata(path).is_ok() {
             return Err(WorldError::Exists {
                 path: path.to_path_buf(),
             });
         }
         let tmp = temporary_path(path);
-        let made = write_new_world(&tmp, preset, seed, layout).and_then(|()| link_into_place(&tmp, path));
+        let made = write_new_world(&tmp, terrain, layout).and_then(|()| link_into_place(&tmp, path));
         // The temporary name is gone after a successful link; remove it on every path.
         let _ = std::fs::remove_file(&tmp);
         let _ = std::fs::remove_file(format::journal_path(&tmp));
@@ -103,24 +104,24 @@ impl World {
         )
         .map_err(|e| sqlite(path, e))?;
         configure(&conn, path)?;
-        let (preset, seed, layout) = verify(&conn, path)?;
+        let (terrain, layout, version) = verify(&conn, path)?;
         // Only now, with the file known to be a world, may anything be written to it.
         set_durability(&conn, path)?;
         Ok(World {
             conn,
             path: path.to_path_buf(),
-            preset,
-            seed,
+            terrain,
             layout,
+            version,
         })
     }
 
     /// Opens the world at `path`, creating it with the given planet when no file exists there.
     /// Returns the world and whether it was created. The planet parameters of an existing world
     /// are not compared with the given ones: see [`World::planet_params`].
-    pub fn open_or_create(path: impl AsRef<Path>, preset: &str, seed: u64, layout: &Layout) -> Result<(World, bool)> {
+    pub fn open_or_create(path: impl AsRef<Path>, terrain: &TerrainSpec, layout: &Layout) -> Result<(World, bool)> {
         let path = path.as_ref();
-        match World::create(path, preset, seed, layout) {
+        match World::create(path, terrain, layout) {
             Ok(w) => Ok((w, true)),
             Err(WorldError::Exists { .. }) => Ok((World::open(path)?, false)),
             Err(e) => Err(e),
@@ -132,9 +133,20 @@ impl World {
         &self.path
     }
 
-    /// The planet: preset name, seed and layout, as stored at creation (they never change).
-    pub fn planet_params(&self) -> (String, u64, Layout) {
-        (self.preset.clone(), self.seed, self.layout)
+    /// The planet: its terrain and layout, as stored at creation (they never change).
+    pub fn planet_params(&self) -> (TerrainSpec, Layout) {
+        (self.terrain.clone(), self.layout)
+    }
+
+    /// The planet's terrain, as stored at creation.
+    pub fn terrain(&self) -> &TerrainSpec {
+        &self.terrain
+    }
+
+    /// The file's format version: 2 for worlds this program creates, 1 for older worlds (which
+    /// are read and edited in place without being rewritten).
+    pub fn format_version(&self) -> u32 {
+        self.version
     }
 
     /// Appends an edit and returns its id. Any undone edits (the redo tail) are discarded first,
@@ -267,14 +279,6 @@ impl World {
     }
 }
 
-/// A preset name is 1 to 64 characters without control characters.
-fn check_preset(preset: &str) -> Result<()> {
-    if preset.is_empty() || preset.chars().count() > 64 || preset.chars().any(char::is_control) {
-        return Err(WorldError::InvalidPreset(preset.to_string()));
-    }
-    Ok(())
-}
-
 fn edit_id(path: &Path, id: i64) -> Result<EditId> {
     u64::try_from(id)
         .ok()
@@ -297,7 +301,7 @@ fn temporary_path(path: &Path) -> PathBuf {
 }
 
 /// Writes a complete, empty world at `tmp` (which must not exist) in one transaction.
-fn write_new_world(tmp: &Path, preset: &str, seed: u64, layout: &Layout) -> Result<()> {
+fn write_new_world(tmp: &Path, terrain: &TerrainSpec, layout: &Layout) -> Result<()> {
     let io = |source| WorldError::Io {
         path: tmp.to_path_buf(),
         source,
@@ -315,7 +319,7 @@ fn write_new_world(tmp: &Path, preset: &str, seed: u64, layout: &Layout) -> Resu
         "BEGIN IMMEDIATE;
          PRAGMA application_id = {APPLICATION_ID};
          PRAGMA user_version = {FORMAT_VERSION};
-         {SCHEMA_V1}
+         {SCHEMA_V2}
          COMMIT;"
     );
     let write = || -> rusqlite::Result<()> {
@@ -330,10 +334,9 @@ fn write_new_world(tmp: &Path, preset: &str, seed: u64, layout: &Layout) -> Resu
             ],
         )?;
         tx.execute(
-            "INSERT INTO planet (id, preset, seed, n_c, n_t, d_b, l_d, d_c) VALUES (1, ?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+            "INSERT INTO planet (id, terrain, n_c, n_t, d_b, l_d, d_c) VALUES (1, ?1, ?2, ?3, ?4, ?5, ?6)",
             params![
-                preset,
-                seed.to_string(),
+                terrain.to_string(),
                 layout.n_c(),
                 layout.n_t(),
                 layout.d_b(),
@@ -440,10 +443,10 @@ fn pragma_check(conn: &Connection, path: &Path, pragma: &str) -> Result<()> {
 }
 
 /// Checks, with SQL, everything the header check could not: the file is sound, it is a world of
-/// this version, its planet parameters are valid, its tables have the columns of version 1, every
-/// edit decodes to a valid brush operation and the undo state is consistent. Returns the planet
-/// parameters.
-fn verify(conn: &Connection, path: &Path) -> Result<(String, u64, Layout)> {
+/// a version this program reads, its planet parameters are valid, its tables have the columns of
+/// its version, every edit decodes to a valid brush operation and the undo state is consistent.
+/// Returns the planet parameters and the format version.
+fn verify(conn: &Connection, path: &Path) -> Result<(TerrainSpec, Layout, u32)> {
     let corrupt = |detail: String| WorldError::Corrupt {
         path: path.to_path_buf(),
         detail,
@@ -475,7 +478,7 @@ fn verify(conn: &Connection, path: &Path) -> Result<(String, u64, Layout)> {
             version,
         });
     }
-    if version != FORMAT_VERSION {
+    if version < OLDEST_FORMAT_VERSION {
         return Err(corrupt(format!("format version {version} in the header")));
     }
     let meta = |key: &str| -> Result<String> {
@@ -489,12 +492,12 @@ fn verify(conn: &Connection, path: &Path) -> Result<(String, u64, Layout)> {
         return Err(corrupt(format!("meta format is {name:?}, not {FORMAT_NAME:?}")));
     }
     let v = meta("version")?;
-    if v != FORMAT_VERSION.to_string() {
+    if v != version.to_string() {
         return Err(corrupt(format!(
             "meta version {v:?} disagrees with the header's format version {version}"
         )));
     }
-    let planet = read_planet(conn, path)?;
+    let (terrain, layout) = read_planet(conn, path, version)?;
     let mut stmt = conn
         .prepare(&format!("SELECT {EDIT_COLUMNS} FROM edits ORDER BY id"))
         .map_err(|e| corrupt(format!("table edits is missing or lacks columns ({e})")))?;
@@ -506,19 +509,21 @@ fn verify(conn: &Connection, path: &Path) -> Result<(String, u64, Layout)> {
     if !is_ok(&findings) {
         return Err(findings_error(path, "quick_check", &findings));
     }
-    Ok(planet)
+    Ok((terrain, layout, version))
 }
 
-/// Reads and validates the single row of table `planet`.
-fn read_planet(conn: &Connection, path: &Path) -> Result<(String, u64, Layout)> {
+/// Reads and validates the single row of table `planet` of a world of format `version`.
+fn read_planet(conn: &Connection, path: &Path, version: u32) -> Result<(TerrainSpec, Layout)> {
     let corrupt = |detail: String| WorldError::Corrupt {
         path: path.to_path_buf(),
         detail: format!("planet parameters: {detail}"),
     };
+    // Version 1 named the terrain by a preset and a seed; version 2 stores its canonical text.
+    let terrain_columns = if version == 1 { "preset, seed" } else { "terrain, ''" };
     type Raw = (String, String, i64, i64, f64, f64, i64);
     let raw: Raw = conn
         .query_row(
-            "SELECT preset, seed, n_c, n_t, d_b, l_d, d_c FROM planet WHERE id = 1",
+            &format!("SELECT {terrain_columns}, n_c, n_t, d_b, l_d, d_c FROM planet WHERE id = 1"),
             [],
             |r| {
                 Ok((
@@ -533,15 +538,29 @@ fn read_planet(conn: &Connection, path: &Path) -> Result<(String, u64, Layout)> 
             },
         )
         .map_err(|e| corrupt(format!("table planet has no readable row 1 ({e})")))?;
-    let (preset, seed, n_c, n_t, d_b, l_d, d_c) = raw;
-    check_preset(&preset).map_err(|e| corrupt(e.to_string()))?;
-    let seed: u64 = seed
-        .parse()
-        .map_err(|_| corrupt(format!("seed {seed:?} is not a decimal number from 0 to 2^64-1")))?;
+    let (text, seed, n_c, n_t, d_b, l_d, d_c) = raw;
+    let terrain = if version == 1 {
+        let seed: u64 = seed
+            .parse()
+            .map_err(|_| corrupt(format!("seed {seed:?} is not a decimal number from 0 to 2^64-1")))?;
+        let kind = text.parse::<PresetKind>().map_err(|_| WorldError::UnknownTerrain {
+            path: path.to_path_buf(),
+            terrain: format!("preset '{text}'"),
+        })?;
+        TerrainSpec::preset(kind, seed)
+    } else {
+        text.parse::<TerrainSpec>().map_err(|e| match text.split(':').next() {
+            Some("preset" | "dem") => corrupt(e.to_string()),
+            _ => WorldError::UnknownTerrain {
+                path: path.to_path_buf(),
+                terrain: format!("{text:?}"),
+            },
+        })?
+    };
     let count = |name: &str, v: i64| u32::try_from(v).map_err(|_| corrupt(format!("{name} = {v} is out of range")));
     let layout = Layout::new(count("n_c", n_c)?, count("n_t", n_t)?, d_b, l_d, count("d_c", d_c)?)
         .map_err(|e| corrupt(e.to_string()))?;
-    Ok((preset, seed, layout))
+    Ok((terrain, layout))
 }
 
 /// The undo state is consistent: every `active` is 0 or 1, and every active edit precedes every

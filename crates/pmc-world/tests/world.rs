@@ -1,6 +1,8 @@
 //! The world file: exact round trips, undo and redo across reopening, refusal of everything that
 //! is not a readable world (without modifying it), and validation of rows edited by hand.
 
+use pmc_density::presets::PresetKind;
+use pmc_density::terrain::{DemSpec, Interpolation, TerrainSpec};
 use pmc_edit::{BrushKind, BrushOp};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
@@ -16,13 +18,17 @@ fn dir(test: &str) -> PathBuf {
     d
 }
 
+fn preset(name: &str, seed: u64) -> TerrainSpec {
+    TerrainSpec::preset(name.parse::<PresetKind>().unwrap(), seed)
+}
+
 fn layout() -> Layout {
     Layout::new(2, 8, 200.0, 2.0, 1).unwrap()
 }
 
 fn new_world(d: &Path) -> (PathBuf, World) {
     let p = d.join("w.world");
-    let w = World::create(&p, "earthlike", 7, &layout()).unwrap();
+    let w = World::create(&p, &preset("earthlike", 7), &layout()).unwrap();
     (p, w)
 }
 
@@ -119,11 +125,11 @@ fn planet_parameters_round_trip() {
     let d = dir("planet");
     let p = d.join("w.world");
     let l = Layout::new(3, 17, 1744.123456789012, 0.1 + 0.2, 5).unwrap();
-    World::create(&p, "mars", u64::MAX, &l).unwrap();
+    World::create(&p, &preset("mars", u64::MAX), &l).unwrap();
     let w = World::open(&p).unwrap();
-    let (preset, seed, back) = w.planet_params();
-    assert_eq!(preset, "mars");
-    assert_eq!(seed, u64::MAX);
+    let (terrain, back) = w.planet_params();
+    assert_eq!(terrain, TerrainSpec::preset(PresetKind::Mars, u64::MAX));
+    assert_eq!(w.format_version(), 2);
     assert_eq!(back, l);
     assert_eq!(back.d_b().to_bits(), l.d_b().to_bits());
     assert_eq!(back.l_d().to_bits(), l.l_d().to_bits());
@@ -197,7 +203,7 @@ fn create_refuses_any_existing_file_and_leaves_it_alone() {
     w.append(&op(BrushKind::Add, 0.0, 0.0, 201.0, 3.0, 1.0)).unwrap();
     drop(w);
     let before = std::fs::read(&p).unwrap();
-    let e = World::create(&p, "moon", 1, &layout()).unwrap_err();
+    let e = World::create(&p, &preset("moon", 1), &layout()).unwrap_err();
     assert!(matches!(e, WorldError::Exists { .. }), "{e}");
     assert!(e.to_string().contains("never overwritten"), "{e}");
     assert_eq!(std::fs::read(&p).unwrap(), before);
@@ -205,14 +211,14 @@ fn create_refuses_any_existing_file_and_leaves_it_alone() {
     let text = d.join("notes.txt");
     std::fs::write(&text, "my notes\n").unwrap();
     assert!(matches!(
-        World::create(&text, "moon", 1, &layout()),
+        World::create(&text, &preset("moon", 1), &layout()),
         Err(WorldError::Exists { .. })
     ));
     assert_eq!(std::fs::read(&text).unwrap(), b"my notes\n");
     let empty = d.join("empty");
     std::fs::write(&empty, "").unwrap();
     assert!(matches!(
-        World::create(&empty, "moon", 1, &layout()),
+        World::create(&empty, &preset("moon", 1), &layout()),
         Err(WorldError::Exists { .. })
     ));
     assert_eq!(std::fs::read(&empty).unwrap(), b"");
@@ -229,18 +235,22 @@ fn create_refuses_any_existing_file_and_leaves_it_alone() {
 fn open_or_create_creates_only_when_missing() {
     let d = dir("open-or-create");
     let p = d.join("w.world");
-    let (mut w, created) = World::open_or_create(&p, "moon", 3, &layout()).unwrap();
+    let (mut w, created) = World::open_or_create(&p, &preset("moon", 3), &layout()).unwrap();
     assert!(created);
     w.append(&op(BrushKind::Add, 0.0, 0.0, 201.0, 3.0, 1.0)).unwrap();
     drop(w);
-    let (w, created) = World::open_or_create(&p, "earthlike", 9, &Layout::default()).unwrap();
+    let (w, created) = World::open_or_create(&p, &preset("earthlike", 9), &Layout::default()).unwrap();
     assert!(!created);
-    assert_eq!(w.planet_params().0, "moon", "the existing world is kept as it is");
+    assert_eq!(
+        w.planet_params().0,
+        preset("moon", 3),
+        "the existing world is kept as it is"
+    );
     assert_eq!(w.edit_count().unwrap(), 1);
     let text = d.join("t.txt");
     std::fs::write(&text, "hello").unwrap();
     assert!(matches!(
-        World::open_or_create(&text, "moon", 3, &layout()),
+        World::open_or_create(&text, &preset("moon", 3), &layout()),
         Err(WorldError::NotSqlite { .. })
     ));
     assert_eq!(std::fs::read(&text).unwrap(), b"hello");
@@ -260,11 +270,6 @@ fn invalid_input_is_refused_before_writing() {
     let huge = BrushOp { radius: 1e9, ..nan };
     assert!(matches!(w.append(&huge), Err(WorldError::InvalidEdit(_))));
     assert_eq!(w.edit_count().unwrap(), 0);
-    assert!(matches!(
-        World::create(d.join("x.world"), "", 1, &layout()),
-        Err(WorldError::InvalidPreset(_))
-    ));
-    assert!(!d.join("x.world").exists());
 }
 
 /// Asserts that opening `p` fails as `want` says, and that the file is byte-identical afterwards
@@ -372,10 +377,10 @@ fn a_newer_world_is_refused_untouched() {
     drop(w);
     Connection::open(&p)
         .unwrap()
-        .pragma_update(None, "user_version", 2)
+        .pragma_update(None, "user_version", 3)
         .unwrap();
-    let e = assert_refused(&p, |e| matches!(e, WorldError::Newer { version: 2, .. }), "upgrade pmc");
-    assert!(e.to_string().contains("version 2"), "{e}");
+    let e = assert_refused(&p, |e| matches!(e, WorldError::Newer { version: 3, .. }), "upgrade pmc");
+    assert!(e.to_string().contains("version 3"), "{e}");
 }
 
 #[test]
@@ -542,7 +547,7 @@ fn rows_edited_by_hand_are_validated_and_named() {
     );
     // A broken planet row.
     std::fs::write(&p, &pristine).unwrap();
-    hand_edit(&p, "UPDATE planet SET seed = ?1", "-5");
+    hand_edit(&p, "UPDATE planet SET terrain = ?1", "preset:earthlike:-5");
     let e = World::open(&p).unwrap_err();
     assert!(
         matches!(e, WorldError::Corrupt { .. }) && e.to_string().contains("seed"),
@@ -604,4 +609,87 @@ fn data_version_changes_only_for_changes_by_other_handles() {
     assert_eq!(a.data_version().unwrap(), v1, "stable without further commits");
     b.redo().unwrap();
     assert_ne!(a.data_version().unwrap(), v1);
+}
+
+#[test]
+fn an_elevation_model_terrain_round_trips() {
+    let d = dir("dem-terrain");
+    let p = d.join("w.world");
+    let dem = TerrainSpec::Dem(DemSpec {
+        path: "../data/earth: 5 minutes.pmcdem".into(),
+        digest: "0123456789abcdef".into(),
+        interpolation: Interpolation::Bilinear,
+        seed: 42,
+    });
+    World::create(&p, &dem, &layout()).unwrap();
+    let w = World::open(&p).unwrap();
+    assert_eq!(w.terrain(), &dem);
+    assert_eq!(w.planet_params(), (dem, layout()));
+}
+
+/// Writes a world of format version 1 (table `planet` with `preset` and `seed`), as pmc wrote
+/// them before terrains became values, with one edit.
+fn write_v1_world(p: &Path, preset: &str) {
+    let conn = Connection::open(p).unwrap();
+    conn.execute_batch(&format!(
+        "PRAGMA application_id = {APPLICATION_ID};
+         PRAGMA user_version = 1;
+         CREATE TABLE meta (key TEXT PRIMARY KEY NOT NULL, value TEXT NOT NULL) WITHOUT ROWID;
+         CREATE TABLE planet (
+             id INTEGER PRIMARY KEY CHECK (id = 1), preset TEXT NOT NULL,
+             seed TEXT NOT NULL CHECK (seed GLOB '[0-9]*' AND seed NOT GLOB '*[^0-9]*'),
+             n_c INTEGER NOT NULL, n_t INTEGER NOT NULL, d_b NOT NULL, l_d NOT NULL, d_c INTEGER NOT NULL);
+         CREATE TABLE edits (
+             id INTEGER PRIMARY KEY AUTOINCREMENT,
+             kind TEXT NOT NULL CHECK (kind IN ('add', 'remove', 'smooth', 'flatten', 'paint')),
+             center_x CHECK (typeof(center_x) = 'real'), center_y CHECK (typeof(center_y) = 'real'),
+             center_z CHECK (typeof(center_z) = 'real'), radius CHECK (typeof(radius) = 'real'),
+             strength CHECK (typeof(strength) = 'real'),
+             material INTEGER CHECK ((kind = 'paint') = (material IS NOT NULL) AND (material IS NULL OR material BETWEEN 0 AND 255)),
+             active INTEGER NOT NULL DEFAULT 1 CHECK (active IN (0, 1)));
+         INSERT INTO meta VALUES ('format', 'pmc-world'), ('version', '1'), ('writer', 'pmc-world 0.1.0');
+         INSERT INTO planet VALUES (1, '{preset}', '9', 2, 8, 200.0, 2.0, 1);
+         INSERT INTO edits (kind, center_x, center_y, center_z, radius, strength) VALUES ('remove', 0.0, 0.0, 210.0, 5.0, 1.0);"
+    ))
+    .unwrap();
+}
+
+#[test]
+fn a_version_1_world_opens_and_stays_version_1() {
+    let d = dir("v1");
+    let p = d.join("old.world");
+    write_v1_world(&p, "moon");
+    let mut w = World::open(&p).unwrap();
+    assert_eq!(w.format_version(), 1);
+    assert_eq!(w.planet_params(), (preset("moon", 9), layout()));
+    assert_eq!(
+        w.active_edits().unwrap(),
+        vec![op(BrushKind::Remove, 0.0, 0.0, 210.0, 5.0, 1.0)]
+    );
+    // Edits go on in place; the file keeps its version.
+    w.append(&op(BrushKind::Add, 0.0, 0.0, 215.0, 3.0, 1.0)).unwrap();
+    drop(w);
+    let w = World::open(&p).unwrap();
+    assert_eq!((w.format_version(), w.edit_count().unwrap()), (1, 2));
+}
+
+#[test]
+fn an_unknown_terrain_is_refused_untouched() {
+    let d = dir("unknown-terrain");
+    let p = d.join("venus.world");
+    write_v1_world(&p, "venus");
+    let e = assert_refused(&p, |e| matches!(e, WorldError::UnknownTerrain { .. }), "upgrade pmc");
+    assert!(e.to_string().contains("venus"), "{e}");
+    let q = d.join("v2.world");
+    World::create(&q, &preset("earth", 1), &layout()).unwrap();
+    Connection::open(&q)
+        .unwrap()
+        .execute("UPDATE planet SET terrain = 'crater:1'", [])
+        .unwrap();
+    assert_refused(&q, |e| matches!(e, WorldError::UnknownTerrain { .. }), "upgrade pmc");
+    Connection::open(&q)
+        .unwrap()
+        .execute("UPDATE planet SET terrain = 'dem:bicubic:x:00:a.pmcdem'", [])
+        .unwrap();
+    assert_refused(&q, |e| matches!(e, WorldError::Corrupt { .. }), "seed");
 }

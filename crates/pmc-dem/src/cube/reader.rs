@@ -176,18 +176,16 @@ impl CubeDem {
     }
 
     /// Bounds of every height [`CubeDem::height`] can return with the default
-    /// [`DetailNoise`]: the data range widened by the bicubic overshoot and the noise bound.
+    /// [`DetailNoise`]: the data range widened by the noise bound.
     pub fn height_bounds(&self) -> (f64, f64) {
         self.height_bounds_with(&DetailNoise::default())
     }
 
-    /// Bounds of every height [`CubeDem::height`] can return with `detail`: the data range,
-    /// widened by the most that bicubic interpolation can overshoot it (`0.28125` of the range:
-    /// Catmull-Rom weights sum to one with absolute values summing to at most `1.25^2`) and by
-    /// [`DetailNoise::bound`].
+    /// Bounds of every height [`CubeDem::height`] can return with `detail`: the data range
+    /// (bicubic interpolation is clamped to it), widened by [`DetailNoise::bound`].
     pub fn height_bounds_with(&self, detail: &DetailNoise) -> (f64, f64) {
         let (min, max) = (self.header.min, self.header.max);
-        let widen = 0.28125 * (max - min) + detail.bound(self.data_spacing());
+        let widen = detail.bound(self.data_spacing());
         (min - widen, max + widen)
     }
 
@@ -283,7 +281,7 @@ impl CubeDem {
     }
 
     /// The decoded tile `idx`, from the cache or the file.
-    fn tile(&self, idx: u64) -> Result<Arc<Vec<f32>>, DemError> {
+    pub(crate) fn tile(&self, idx: u64) -> Result<Arc<Vec<f32>>, DemError> {
         let shard = &self.shards[(idx % SHARDS as u64) as usize];
         if let Some(t) = shard.lock().unwrap_or_else(|p| p.into_inner()).map.get(&idx) {
             return Ok(Arc::clone(t));

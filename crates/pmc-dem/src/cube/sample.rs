@@ -6,18 +6,7 @@ use super::reader::CubeDem;
 use pmc_geometry::glam::{DVec3, IVec3};
 use pmc_geometry::{face_uv_to_cube, sphere_to_face_uv, Face};
 
-/// How heights between data samples are interpolated. Both pass exactly through the samples.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Interpolation {
-    /// Bilinear in the face's sample indices (continuous, creased along sample rows).
-    #[default]
-    Bilinear,
-    /// Catmull-Rom bicubic in the face's sample indices (continuous first derivative within a
-    /// face). Samples past a face edge come from the neighbouring face, unfolded about the
-    /// edge; along the two edges through a cube corner the samples past the corner are the
-    /// corner's (clamped), so both faces of an edge interpolate it from the same samples.
-    Bicubic,
-}
+pub use pmc_density::terrain::Interpolation;
 
 /// The largest lattice resolution [`CubeDem::height_at_lattice`] accepts: `2^30`.
 pub const MAX_LATTICE_RESOLUTION: i32 = 1 << 30;
@@ -92,6 +81,92 @@ impl CubeDem {
         detail.relief_weight(most, self.data_spacing())
     }
 
+    /// The 4 x 4 data samples `(i0 - 1 + di, j0 - 1 + dj)` at `[dj * 4 + di]`, when they all lie
+    /// on `face` in one tile (most calls): one cache lookup instead of one per sample. `None`
+    /// near face edges and tile borders, where the per-sample path (with its unfolding) runs.
+    fn block(&self, face: Face, i0: i32, j0: i32) -> Option<[f64; 16]> {
+        let r = 1i32 << self.header.n;
+        if i0 < 1 || j0 < 1 || i0 + 2 > r || j0 + 2 > r {
+            return None;
+        }
+        let t = self.header.tile as i32;
+        if (i0 - 1) / t != (i0 + 2) / t || (j0 - 1) / t != (j0 + 2) / t {
+            return None;
+        }
+        let (i, j) = ((i0 - 1) as u32, (j0 - 1) as u32);
+        let idx = self.grid.index_of(0, face.index(), i, j);
+        let tile = self.tile(idx).ok()?;
+        let mut out = [0.0; 16];
+        if tile.len() == 1 {
+            out.fill(f64::from(tile[0]));
+            return Some(out);
+        }
+        let t = self.header.tile;
+        let w = (self.grid.levels[0].side.min((i / t) * t + t) - (i / t) * t) as usize;
+        let (ci, cj) = ((i % t) as usize, (j % t) as usize);
+        for dj in 0..4 {
+            let row = (cj + dj) * w + ci;
+            for di in 0..4 {
+                out[dj * 4 + di] = f64::from(tile[row + di]);
+            }
+        }
+        Some(out)
+    }
+
+    /// [`CubeDem::interpolate`] from a 4 x 4 block of samples (see [`CubeDem::block`]): the same
+    /// operations in the same order, so the same bits.
+    fn interpolate_block(
+        &self,
+        b: &[f64; 16],
+        fs: f64,
+        ft: f64,
+        interp: Interpolation,
+        detail: &DetailNoise,
+    ) -> (f64, f64) {
+        let value = match interp {
+            Interpolation::Bilinear => {
+                let (a, bb, c, d) = (b[5], b[6], b[9], b[10]);
+                let lo = a + fs * (bb - a);
+                let hi = c + fs * (d - c);
+                lo + ft * (hi - lo)
+            }
+            Interpolation::Bicubic => {
+                let ws = catmull_rom(fs);
+                let wt = catmull_rom(ft);
+                let mut total = 0.0;
+                for (dj, wj) in wt.iter().enumerate() {
+                    let row: f64 = ws.iter().enumerate().map(|(di, wi)| wi * b[dj * 4 + di]).sum();
+                    total += wj * row;
+                }
+                total.clamp(self.header.min, self.header.max)
+            }
+        };
+        if !detail.is_on() {
+            return (value, 1.0);
+        }
+        // The relief weight of a sample from its four neighbours, in `relief`'s order.
+        let relief = |x: usize, y: usize| -> f64 {
+            let h = b[y * 4 + x];
+            let mut most = 0.0f64;
+            for v in [
+                b[y * 4 + x - 1],
+                b[y * 4 + x + 1],
+                b[(y - 1) * 4 + x],
+                b[(y + 1) * 4 + x],
+            ] {
+                most = most.max((v - h).abs());
+            }
+            if h.is_nan() {
+                return f64::NAN;
+            }
+            detail.relief_weight(most, self.data_spacing())
+        };
+        let (a, bb, c, d) = (relief(1, 1), relief(2, 1), relief(1, 2), relief(2, 2));
+        let lo = a + fs * (bb - a);
+        let hi = c + fs * (d - c);
+        (value, lo + ft * (hi - lo))
+    }
+
     /// Interpolated data at fractional sample indices `(s, t)` of `face`, and the relief weight
     /// of the detail there (1 when the detail is off).
     fn interpolate(&self, face: Face, s: f64, t: f64, interp: Interpolation, detail: &DetailNoise) -> (f64, f64) {
@@ -104,6 +179,24 @@ impl CubeDem {
         let i0 = (s.floor() as i32).min(r - 1);
         let j0 = (t.floor() as i32).min(r - 1);
         let (fs, ft) = (s - f64::from(i0), t - f64::from(j0));
+        if let Some(b) = self.block(face, i0, j0) {
+            return self.interpolate_block(&b, fs, ft, interp, detail);
+        }
+        self.interpolate_samples(face, i0, j0, fs, ft, interp, detail)
+    }
+
+    /// [`CubeDem::interpolate`] sample by sample, unfolding past face edges.
+    #[allow(clippy::too_many_arguments)]
+    fn interpolate_samples(
+        &self,
+        face: Face,
+        i0: i32,
+        j0: i32,
+        fs: f64,
+        ft: f64,
+        interp: Interpolation,
+        detail: &DetailNoise,
+    ) -> (f64, f64) {
         let value = match interp {
             Interpolation::Bilinear => {
                 let a = self.data(face, i0, j0);
@@ -127,7 +220,10 @@ impl CubeDem {
                         .sum();
                     total += wj * row;
                 }
-                total
+                // Catmull-Rom may overshoot the data; clamped to the data's range (a
+                // continuous operation, the identity at every sample) the heights stay within
+                // known bounds, so a planet's shell need not make room for the overshoot.
+                total.clamp(self.header.min, self.header.max)
             }
         };
         if !detail.is_on() {
@@ -217,5 +313,51 @@ impl CubeDem {
             octaves += 1;
         }
         value + weight * detail.sum(face_uv_to_cube(face, u, v) * half, octaves, spacing)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cube::{import_cube, ImportOptions};
+    use crate::EquirectDem;
+
+    #[test]
+    fn a_block_gives_the_bits_of_sample_by_sample_interpolation() {
+        let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/etopo60.cdf");
+        let dem = EquirectDem::read_netcdf(&src, None).unwrap();
+        let dir = std::env::temp_dir().join(format!("pmc-dem-block-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("b.pmcdem");
+        let options = ImportOptions {
+            level: Some(7),
+            tile_size: 16,
+            ..ImportOptions::default()
+        };
+        import_cube(&dem, &out, &options, &|_, _| {}).unwrap();
+        let cube = CubeDem::open(&out).unwrap();
+        let detail = DetailNoise::default();
+        let mut blocks = 0;
+        for face in Face::ALL {
+            for k in 0..400u32 {
+                let s = f64::from(k % 20) * 6.37 + 0.25 * f64::from(k % 3);
+                let t = f64::from(k / 20) * 6.41 + 0.5;
+                let (i0, j0) = (s.floor() as i32, t.floor() as i32);
+                let Some(b) = cube.block(face, i0, j0) else { continue };
+                blocks += 1;
+                let (fs, ft) = (s - f64::from(i0), t - f64::from(j0));
+                for interp in [Interpolation::Bilinear, Interpolation::Bicubic] {
+                    let fast = cube.interpolate_block(&b, fs, ft, interp, &detail);
+                    let slow = cube.interpolate_samples(face, i0, j0, fs, ft, interp, &detail);
+                    assert_eq!(
+                        (fast.0.to_bits(), fast.1.to_bits()),
+                        (slow.0.to_bits(), slow.1.to_bits()),
+                        "{face:?} {s} {t}"
+                    );
+                }
+            }
+        }
+        assert!(blocks > 1000, "{blocks}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -869,8 +869,7 @@ impl Shader for EarthShader {
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(EarthModel::new(seed, layout));
     Terrain {
-        kind: PresetKind::Earth,
-        seed,
+        spec: crate::terrain::TerrainSpec::preset(PresetKind::Earth, seed),
         sea_radius: Some(model.sea()),
         shader: Arc::new(EarthShader::new(model.clone(), seed)),
         density: Arc::new(EarthDensity(model)),

@@ -295,8 +295,7 @@ impl Shader for EarthShader {
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(EarthModel::new(seed, layout));
     Terrain {
-        kind: PresetKind::Earthlike,
-        seed,
+        spec: crate::terrain::TerrainSpec::preset(PresetKind::Earthlike, seed),
         sea_radius: Some(model.sea()),
         shader: Arc::new(EarthShader::new(model.clone(), seed)),
         density: Arc::new(ColumnDensity(model)),

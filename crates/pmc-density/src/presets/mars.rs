@@ -308,8 +308,7 @@ impl Shader for MarsShader {
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(MarsModel::new(seed, layout));
     Terrain {
-        kind: PresetKind::Mars,
-        seed,
+        spec: crate::terrain::TerrainSpec::preset(PresetKind::Mars, seed),
         sea_radius: None,
         shader: Arc::new(MarsShader::new(model.clone(), seed)),
         density: Arc::new(ColumnDensity(model)),
@@ -329,7 +328,7 @@ mod tests {
         let layout = Layout::default();
         let t = build(4, &layout);
         assert!(t.sea_radius.is_none());
-        assert_eq!(t.kind, PresetKind::Mars);
+        assert_eq!(t.spec.preset_kind(), Some(PresetKind::Mars));
         check_surface_within_bounds(&t, &layout);
     }
 

@@ -3,14 +3,14 @@
 mod craters;
 mod earth;
 mod earthlike;
-mod features;
+pub(crate) mod features;
 mod layouts;
 mod mars;
 mod moon;
-mod shading;
+pub(crate) mod shading;
 mod sphere;
 #[cfg(test)]
-mod testing;
+pub(crate) mod testing;
 
 use crate::Density;
 pub use layouts::{layout_for_radius, RadiusError, EARTH_RADIUS, MAX_RADIUS, MIN_RADIUS};
@@ -123,10 +123,8 @@ pub const UNKNOWN_MATERIAL_COLOR: [u8; 4] = [128, 128, 128, 255];
 /// A planet's terrain: density, sea and look, ready to mesh.
 #[derive(Clone)]
 pub struct Terrain {
-    /// The preset it was built from.
-    pub kind: PresetKind,
-    /// The seed it was built with.
-    pub seed: u64,
+    /// What it was built from (a preset and a seed, or an elevation model).
+    pub spec: crate::terrain::TerrainSpec,
     /// The density field (positive solid).
     pub density: Arc<dyn Density>,
     /// Radius of the sea surface, if the planet has a sea.
@@ -143,8 +141,7 @@ pub struct Terrain {
 impl std::fmt::Debug for Terrain {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Terrain")
-            .field("kind", &self.kind)
-            .field("seed", &self.seed)
+            .field("spec", &self.spec)
             .field("sea_radius", &self.sea_radius)
             .finish()
     }
@@ -190,7 +187,7 @@ mod tests {
         for kind in PresetKind::ALL {
             let a = build(kind, 11, &layout);
             let b = build(kind, 11, &layout);
-            assert_eq!((a.kind, a.seed), (kind, 11));
+            assert_eq!(a.spec, crate::terrain::TerrainSpec::preset(kind, 11));
             assert!(!a.materials.is_empty());
             let mut va = vec![0.0f32; dirs.len() * radii.len()];
             let mut vb = va.clone();

@@ -212,8 +212,7 @@ impl Shader for MoonShader {
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(MoonModel::new(seed, layout));
     Terrain {
-        kind: PresetKind::Moon,
-        seed,
+        spec: crate::terrain::TerrainSpec::preset(PresetKind::Moon, seed),
         sea_radius: None,
         shader: Arc::new(MoonShader::new(model.clone(), seed)),
         density: Arc::new(ColumnDensity(model)),
@@ -233,7 +232,7 @@ mod tests {
         let layout = Layout::default();
         let t = build(4, &layout);
         assert!(t.sea_radius.is_none());
-        assert_eq!(t.kind, PresetKind::Moon);
+        assert_eq!(t.spec.preset_kind(), Some(PresetKind::Moon));
         check_surface_within_bounds(&t, &layout);
     }
 

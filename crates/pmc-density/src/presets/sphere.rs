@@ -40,8 +40,7 @@ impl Shader for Grey {
 /// Builds the sphere terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     Terrain {
-        kind: PresetKind::Sphere,
-        seed,
+        spec: crate::terrain::TerrainSpec::preset(PresetKind::Sphere, seed),
         density: Arc::new(Sphere { radius: radius(layout) }),
         sea_radius: None,
         shader: Arc::new(Grey(Material::srgb([150, 150, 146], [150, 150, 146]).color(0.0))),

@@ -20,8 +20,7 @@ pub fn small_layout() -> Layout {
 pub fn small_config() -> ServerConfig {
     ServerConfig {
         port: 0,
-        preset: PresetKind::Earthlike,
-        seed: 3,
+        terrain: pmc_planet::TerrainSpec::preset(PresetKind::Earthlike, 3),
         layout: small_layout(),
         threads: 2,
         ..ServerConfig::default()

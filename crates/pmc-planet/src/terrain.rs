@@ -1,0 +1,66 @@
+//! Building a planet's terrain from its [`TerrainSpec`]: a preset, or an elevation model.
+
+use pmc_density::presets::{self, Terrain};
+use pmc_density::terrain::{ReliefError, TerrainSpec};
+use pmc_geometry::Layout;
+
+/// Why a terrain could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum TerrainError {
+    /// The elevation model could not be opened or read (the message names the file).
+    #[error(transparent)]
+    Dem(#[from] pmc_dem::DemError),
+    /// The elevation file is not the one the terrain was made from: its content digest differs.
+    /// Fix: give the file the planet (or world) was made with, or make a new world for this one.
+    #[error(
+        "{path}: this elevation file's digest is {found}, but the planet was made from the file with digest {expected}; give that file, or start a new world for this one"
+    )]
+    DigestMismatch {
+        /// The file opened.
+        path: String,
+        /// The digest the terrain records.
+        expected: String,
+        /// The digest of the file.
+        found: String,
+    },
+    /// The relief does not fit the layout's shell.
+    #[error("{path}: {source}")]
+    Relief {
+        /// The elevation file.
+        path: String,
+        /// What does not fit.
+        #[source]
+        source: ReliefError,
+    },
+}
+
+/// The terrain `spec` describes, built for `layout`. Presets never fail; an elevation model is
+/// opened (its path as given, relative to the working directory), its digest checked against
+/// the spec's, and its relief fitted into the layout's shell.
+pub fn build_terrain(spec: &TerrainSpec, layout: &Layout) -> Result<Terrain, TerrainError> {
+    match spec {
+        TerrainSpec::Preset { kind, seed } => Ok(presets::build(*kind, *seed, layout)),
+        TerrainSpec::Dem(dem) => pmc_dem::dem_terrain(dem, layout).map_err(|e| match e {
+            pmc_dem::DemTerrainError::Dem(e) => TerrainError::Dem(e),
+            pmc_dem::DemTerrainError::DigestMismatch { expected, found } => TerrainError::DigestMismatch {
+                path: dem.path.clone(),
+                expected,
+                found,
+            },
+            pmc_dem::DemTerrainError::Relief(source) => TerrainError::Relief {
+                path: dem.path.clone(),
+                source,
+            },
+        }),
+    }
+}
+
+/// The layout a terrain is made for when none is given: the preset's own
+/// ([`PresetKind::default_layout`](presets::PresetKind::default_layout)), or for an elevation
+/// model the layout chosen for its body's radius ([`presets::layout_for_radius`]).
+pub fn default_layout(spec: &TerrainSpec) -> Result<Layout, TerrainError> {
+    match spec {
+        TerrainSpec::Preset { kind, .. } => Ok(kind.default_layout(None).expect("every preset has a default layout")),
+        TerrainSpec::Dem(dem) => Ok(pmc_dem::dem_layout(dem)?),
+    }
+}
