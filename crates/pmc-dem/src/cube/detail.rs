@@ -26,7 +26,7 @@ pub const MAX_DETAIL_OCTAVES: u32 = 30;
 /// exact, and a lattice point of resolution `2^(n+j)` gets only octaves `0 .. j`.
 ///
 /// Octave `k` has amplitude `roughness x data spacing / 2^k` (metres; the data spacing at a face
-/// centre), times a relief weight in `[0, 1]`: at each data sample the largest height
+/// centre; octave 0 at most `max_amplitude`), times a relief weight in `[0, 1]`: at each data sample the largest height
 /// difference to its four neighbours divided by `relief_slope x data spacing` (capped at 1),
 /// interpolated bilinearly between the samples, so flat areas stay smooth. `relief_slope <= 0`
 /// turns the weighting off (weight 1 everywhere).
@@ -39,7 +39,14 @@ pub struct DetailNoise {
     /// Slope of the data at and above which the detail has its full amplitude; 0 or less: no
     /// relief weighting.
     pub relief_slope: f64,
+    /// The largest amplitude of octave 0, metres: coarse data (a sample every 100 km) gets
+    /// hills, not mountain ranges, between its samples. Infinite: no cap.
+    pub max_amplitude: f64,
 }
+
+/// Default cap on the amplitude of octave 0, metres (so the detail moves the surface by at most
+/// twice this).
+pub const DEFAULT_MAX_AMPLITUDE: f64 = 400.0;
 
 impl Default for DetailNoise {
     fn default() -> Self {
@@ -47,6 +54,7 @@ impl Default for DetailNoise {
             seed: DEFAULT_DETAIL_SEED,
             roughness: DEFAULT_ROUGHNESS,
             relief_slope: DEFAULT_RELIEF_SLOPE,
+            max_amplitude: DEFAULT_MAX_AMPLITUDE,
         }
     }
 }
@@ -57,6 +65,7 @@ impl DetailNoise {
         seed: DEFAULT_DETAIL_SEED,
         roughness: 0.0,
         relief_slope: 0.0,
+        max_amplitude: 0.0,
     };
 
     /// Whether any detail is added.
@@ -64,12 +73,24 @@ impl DetailNoise {
         self.roughness != 0.0 && self.roughness.is_finite()
     }
 
+    /// The amplitude of octave 0, metres, for data spacing `spacing` metres: `roughness x
+    /// spacing`, at most `max_amplitude` in size.
+    pub fn amplitude(&self, spacing: f64) -> f64 {
+        let a = self.roughness * spacing;
+        let cap = self.max_amplitude.abs();
+        if cap.is_nan() {
+            a
+        } else {
+            a.clamp(-cap, cap)
+        }
+    }
+
     /// The most the detail can add or remove, in metres, for data spacing `spacing` metres:
-    /// `|roughness| x spacing x (1 + 1/2 + 1/4 + ...) = 2 |roughness| spacing` (each octave lies
-    /// in `[-1, 1]` times its amplitude, the weight in `[0, 1]`).
+    /// `|amplitude| x (1 + 1/2 + 1/4 + ...) = 2 |amplitude|` (each octave lies in `[-1, 1]`
+    /// times its amplitude, the weight in `[0, 1]`).
     pub fn bound(&self, spacing: f64) -> f64 {
         if self.is_on() {
-            2.0 * self.roughness.abs() * spacing
+            2.0 * self.amplitude(spacing).abs()
         } else {
             0.0
         }
@@ -92,7 +113,7 @@ impl DetailNoise {
         let octaves = octaves.min(MAX_DETAIL_OCTAVES) as usize;
         let mut total = 0.0;
         let mut scale = 1.0;
-        let mut amp = self.roughness * spacing;
+        let mut amp = self.amplitude(spacing);
         let mut k = 0;
         while k < octaves {
             let lanes = (octaves - k).min(LANES);
@@ -128,7 +149,7 @@ mod tests {
         for (i, octaves) in [0u32, 1, 2, 7, 8, 9, 13, 24, 30].into_iter().enumerate() {
             let p = DVec3::new(12.3 + i as f64, -45.6, 789.01);
             let mut total = 0.0;
-            let (mut scale, mut amp) = (1.0, d.roughness * 9000.0);
+            let (mut scale, mut amp) = (1.0, d.amplitude(9000.0));
             for k in 0..octaves {
                 total += amp * gradient3(p * scale, derive_seed(d.seed, u64::from(k)));
                 scale *= 2.0;

@@ -11,7 +11,10 @@ mod reader;
 mod sample;
 mod source_grid;
 
-pub use detail::{DetailNoise, DEFAULT_DETAIL_SEED, DEFAULT_RELIEF_SLOPE, DEFAULT_ROUGHNESS, MAX_DETAIL_OCTAVES};
+pub use detail::{
+    DetailNoise, DEFAULT_DETAIL_SEED, DEFAULT_MAX_AMPLITUDE, DEFAULT_RELIEF_SLOPE, DEFAULT_ROUGHNESS,
+    MAX_DETAIL_OCTAVES,
+};
 pub use format::{
     stored_levels, SampleFormat, COARSEST_OVERVIEW_LOG2, DEFAULT_TILE_SIZE, HEADER_BYTES, MAGIC, MAX_DATA_LEVEL,
     VERSION,
