@@ -95,6 +95,7 @@ mod tests {
         fn through<H: LatticeHeights>(h: H, p: IVec3) -> f64 {
             h.height(p, 64)
         }
-        assert_eq!(through(&r, p), h);
+        let by_ref: &Ripples = &r;
+        assert_eq!(through(by_ref, p), h);
     }
 }
