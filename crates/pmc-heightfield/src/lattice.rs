@@ -59,9 +59,13 @@ pub fn face_lattice(face: Face, i: i64, j: i64, m: i64) -> Option<IVec3> {
 ///
 /// For a power-of-two `m` the division is exact, so `(2 lattice, 2 m)` gives the same bits: a
 /// point has one direction at every level.
+///
+/// `m` must be a power of two: the division is done as a multiplication by the exact reciprocal
+/// `1 / m`, which gives the bits of the division only then.
 #[inline]
 pub fn lattice_direction(lattice: IVec3, m: i64) -> DVec3 {
-    cube_to_sphere(lattice.as_dvec3() / m as f64)
+    debug_assert!(m > 0 && m.count_ones() == 1, "resolution {m} is not a power of two");
+    cube_to_sphere(lattice.as_dvec3() * (1.0 / m as f64))
 }
 
 /// The lattice point `lattice` of resolution `m` (a power of two, at most
@@ -138,5 +142,7 @@ mod tests {
             assert_eq!(lattice_direction(q, 64 << k), d);
         }
         assert_eq!(lattice_direction(canonical_lattice(p, 64), CANONICAL_RESOLUTION), d);
+        // The reciprocal gives the division's bits.
+        assert_eq!(d, cube_to_sphere(p.as_dvec3() / 64.0));
     }
 }

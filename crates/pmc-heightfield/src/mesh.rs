@@ -6,6 +6,7 @@ use crate::patch::{Corner, PatchError, PatchKey, Side, Stitch};
 use pmc_geometry::glam::{DVec3, IVec3};
 use pmc_geometry::{EdgeKey, VoxelKey};
 use pmc_mesh::ChunkMesh;
+use std::cell::RefCell;
 use std::sync::OnceLock;
 
 /// Side of the sample grid: the patch's 65 vertices plus one border sample on each side.
@@ -35,7 +36,7 @@ fn cross(a: DVec3, b: DVec3) -> DVec3 {
 
 #[inline]
 fn unit_f32(n: DVec3) -> [f32; 3] {
-    let n = n / n.length();
+    let n = n * (1.0 / n.length());
     [n.x as f32, n.y as f32, n.z as f32]
 }
 
@@ -87,9 +88,8 @@ struct Samples<'a, H: ?Sized> {
     key: PatchKey,
     radius: f64,
     m: i64,
-    pos: Vec<DVec3>,
-    lattice: Vec<IVec3>,
-    h: Vec<f64>,
+    pos: &'a [DVec3],
+    lattice: &'a [IVec3],
 }
 
 impl<H: LatticeHeights + ?Sized> Samples<'_, H> {
@@ -176,54 +176,77 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
         return Err(PatchError::InvalidParameter("radius must be finite and positive"));
     }
     let m = key.resolution();
+    SCRATCH.with(|scratch| {
+        let mut scratch = scratch.borrow_mut();
+        let Scratch { lattice, hs, pos } = &mut *scratch;
+        fill_lattice(key, lattice);
+        hs.resize(lattice.len(), 0.0);
+        heights.heights(lattice, m as i32, hs);
+        pos.clear();
+        pos.extend(
+            lattice
+                .iter()
+                .zip(hs.iter())
+                .map(|(p, h)| lattice_direction(*p, m) * (radius + h)),
+        );
+        let samples = Samples {
+            heights,
+            key,
+            radius,
+            m,
+            pos,
+            lattice,
+        };
+        write_mesh(&samples, hs, stitch, out);
+    });
+    Ok(())
+}
+
+/// Per-thread sample buffers, so that generating a patch allocates nothing once warm.
+#[derive(Default)]
+struct Scratch {
+    lattice: Vec<IVec3>,
+    hs: Vec<f64>,
+    pos: Vec<DVec3>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// The lattice points of the 67 × 67 sample grid: the patch incrementally, the border by
+/// unfolding. The four grid corners are never read; they repeat the nearest patch corner so that
+/// every entry is a valid point.
+fn fill_lattice(key: PatchKey, lattice: &mut Vec<IVec3>) {
     let fr = key.face.frame();
     let base = key.vertex_lattice(0, 0).expect("patch corner lies on the face");
     let (du, dv) = (fr.u * 2, fr.v * 2);
-
-    // Lattice points of the grid: the patch incrementally, the border by unfolding.
-    let mut lattice = vec![IVec3::ZERO; GRID * GRID];
-    let mut points = Vec::with_capacity(GRID * GRID);
-    let mut slots = Vec::with_capacity(GRID * GRID);
+    lattice.clear();
     for b in -1..=SEG + 1 {
         let border_row = !(0..=SEG).contains(&b);
         for a in -1..=SEG + 1 {
             let border_col = !(0..=SEG).contains(&a);
-            if border_row && border_col {
-                continue;
-            }
-            let p = if border_row || border_col {
+            let p = if border_row && border_col {
+                let (ca, cb) = (a.clamp(0, SEG), b.clamp(0, SEG));
+                base + du * ca as i32 + dv * cb as i32
+            } else if border_row || border_col {
                 key.vertex_lattice(a, b)
                     .expect("border samples lie past one edge at most")
             } else {
                 base + du * a as i32 + dv * b as i32
             };
-            let g = Samples::<H>::g(a, b);
-            lattice[g] = p;
-            points.push(p);
-            slots.push(g);
+            lattice.push(p);
         }
     }
-    let mut hs = vec![0.0; points.len()];
-    heights.heights(&points, m as i32, &mut hs);
-    let mut pos = vec![DVec3::ZERO; GRID * GRID];
-    let mut h = vec![0.0; GRID * GRID];
-    for ((p, hv), g) in points.iter().zip(&hs).zip(&slots) {
-        pos[*g] = lattice_direction(*p, m) * (radius + hv);
-        h[*g] = *hv;
-    }
-    let samples = Samples {
-        heights,
-        key,
-        radius,
-        m,
-        pos,
-        lattice,
-        h,
-    };
+}
 
+fn write_mesh<H: LatticeHeights + ?Sized>(samples: &Samples<'_, H>, hs: &[f64], stitch: Stitch, out: &mut ChunkMesh) {
+    let g = |a: i64, b: i64| (b + 1) as usize * GRID + (a + 1) as usize;
+    let pos = samples.pos;
+    let m = samples.m;
     out.clear();
     let centre = SEG / 2;
-    let origin = samples.pos[Samples::<H>::g(centre, centre)];
+    let origin = pos[g(centre, centre)];
     out.origin = origin;
     let n = SIDE * SIDE;
     out.positions.reserve(n);
@@ -231,22 +254,26 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
     out.edge_keys.reserve(n);
     out.heights.reserve(n);
     for b in 0..=SEG {
+        let border_row = b == 0 || b == SEG;
         for a in 0..=SEG {
-            let g = Samples::<H>::g(a, b);
-            let p = samples.pos[g] - origin;
+            let k = g(a, b);
+            let p = pos[k] - origin;
             out.positions.push([p.x as f32, p.y as f32, p.z as f32]);
-            let s = spacing(stitch, a, b);
-            out.normals.push(unit_f32(samples.normal(a, b, s)));
-            let c = VoxelKey::new(canonical_lattice(samples.lattice[g], m), 0).pack();
+            let normal = if border_row || a == 0 || a == SEG {
+                samples.normal(a, b, spacing(stitch, a, b))
+            } else {
+                cross(pos[k + 1] - pos[k - 1], pos[k + GRID] - pos[k - GRID])
+            };
+            out.normals.push(unit_f32(normal));
+            let c = VoxelKey::new(canonical_lattice(samples.lattice[k], m), 0).pack();
             out.edge_keys.push(EdgeKey(c, c));
-            out.heights.push(samples.h[g] as f32);
+            out.heights.push(hs[k] as f32);
         }
     }
     out.water_depths.resize(n, 0.0);
     out.colors.resize(n, PATCH_COLOR);
     out.materials.resize(n, 0);
     out.indices.extend_from_slice(patch_indices(stitch.side_bits()));
-    Ok(())
 }
 
 /// The stencil spacing of vertex `(a, b)`: 2 where a coarser patch holds the vertex, else 1.
