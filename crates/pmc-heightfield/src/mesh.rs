@@ -249,25 +249,42 @@ fn write_mesh<H: LatticeHeights + ?Sized>(samples: &Samples<'_, H>, hs: &[f64], 
     let origin = pos[g(centre, centre)];
     out.origin = origin;
     let n = SIDE * SIDE;
-    out.positions.reserve(n);
-    out.normals.reserve(n);
-    out.edge_keys.reserve(n);
-    out.heights.reserve(n);
-    for b in 0..=SEG {
+    out.positions.resize(n, [0.0; 3]);
+    out.normals.resize(n, [0.0; 3]);
+    out.edge_keys.resize(n, EdgeKey(0, 0));
+    out.heights.resize(n, 0.0);
+    let rows = out
+        .positions
+        .chunks_exact_mut(SIDE)
+        .zip(out.normals.chunks_exact_mut(SIDE))
+        .zip(
+            out.edge_keys
+                .chunks_exact_mut(SIDE)
+                .zip(out.heights.chunks_exact_mut(SIDE)),
+        );
+    for (b, ((positions, normals), (keys, heights))) in (0..=SEG).zip(rows) {
+        let row = g(0, b);
+        let (p_row, h_row, l_row) = (
+            &pos[row..row + SIDE],
+            &hs[row..row + SIDE],
+            &samples.lattice[row..row + SIDE],
+        );
+        for a in 0..SIDE {
+            let d = p_row[a] - origin;
+            positions[a] = [d.x as f32, d.y as f32, d.z as f32];
+            heights[a] = h_row[a] as f32;
+            let c = VoxelKey::new(canonical_lattice(l_row[a], m), 0).pack();
+            keys[a] = EdgeKey(c, c);
+        }
         let border_row = b == 0 || b == SEG;
-        for a in 0..=SEG {
-            let k = g(a, b);
-            let p = pos[k] - origin;
-            out.positions.push([p.x as f32, p.y as f32, p.z as f32]);
+        for (a, nrm) in (0..=SEG).zip(normals.iter_mut()) {
+            let k = row + a as usize;
             let normal = if border_row || a == 0 || a == SEG {
                 samples.normal(a, b, spacing(stitch, a, b))
             } else {
                 cross(pos[k + 1] - pos[k - 1], pos[k + GRID] - pos[k - GRID])
             };
-            out.normals.push(unit_f32(normal));
-            let c = VoxelKey::new(canonical_lattice(samples.lattice[k], m), 0).pack();
-            out.edge_keys.push(EdgeKey(c, c));
-            out.heights.push(hs[k] as f32);
+            *nrm = unit_f32(normal);
         }
     }
     out.water_depths.resize(n, 0.0);
