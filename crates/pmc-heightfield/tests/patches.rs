@@ -230,3 +230,52 @@ fn the_depth_cap_and_far_views() {
     assert_eq!(far.len(), 6);
     assert!(far.iter().all(|p| p.stitch.is_none()));
 }
+
+#[test]
+fn bounding_spheres_hold_every_vertex_and_culled_patches_are_hidden() {
+    let planet = HeightfieldPlanet::new(RADIUS, -3000.0, 3000.0, 10).unwrap();
+    let keys = [
+        PatchKey::root(Face::Top),
+        PatchKey::new(Face::East, 1, 1, 0).unwrap(),
+        PatchKey::new(Face::South, 3, 0, 7).unwrap(),
+        PatchKey::new(Face::West, 6, 63, 20).unwrap(),
+        PatchKey::new(Face::Bottom, 10, 512, 1023).unwrap(),
+    ];
+    for key in keys {
+        let s = planet.bounding_sphere(key);
+        let m = mesh(key, Stitch::NONE);
+        for v in 0..m.vertex_count() {
+            assert!((world(&m, v) - s.center).length() <= s.radius, "{key}");
+        }
+    }
+    // Culled patches: every vertex lies behind the occluder ball seen from the camera.
+    let cam = DVec3::new(-0.2, 0.9, 0.4).normalize() * (RADIUS + 400_000.0);
+    let view = View::perspective(cam, 1.0, 1080.0, 2.0);
+    let patches = select(&view, &planet).unwrap();
+    let rho = planet.occluder_radius();
+    let hidden: Vec<_> = patches.iter().filter(|p| !p.visible).collect();
+    assert!(!hidden.is_empty());
+    for p in hidden.iter().step_by(7) {
+        let m = mesh(p.key, p.stitch);
+        for v in (0..m.vertex_count()).step_by(13) {
+            let q = world(&m, v);
+            // Closest approach of the segment cam -> q to the centre is inside the ball.
+            let d = q - cam;
+            let t = (-cam.dot(d) / d.length_squared()).clamp(0.0, 1.0);
+            assert!((cam + d * t).length() < rho, "{} vertex {v}", p.key);
+        }
+    }
+}
+
+#[test]
+fn parallel_generation_equals_one_by_one() {
+    let planet = HeightfieldPlanet::new(RADIUS, -3000.0, 3000.0, 6).unwrap();
+    let view = View::perspective(DVec3::new(1.0, 0.2, 0.1).normalize() * (RADIUS * 1.05), 1.0, 720.0, 4.0);
+    let patches = select(&view, &planet).unwrap();
+    let h = heights();
+    let parallel = pmc_heightfield::generate_patches(&h, RADIUS, &patches).unwrap();
+    assert_eq!(parallel.len(), patches.len());
+    for (p, m) in patches.iter().zip(&parallel).step_by(5) {
+        assert_eq!(*m, mesh(p.key, p.stitch));
+    }
+}
