@@ -7,6 +7,11 @@
 //! - `dem2049+fbm4`: a bilinear lookup into a 2049 x 2049 table addressed by the face coordinates
 //!   of the cube point, plus 4 noise octaves, the cost of a DEM with noise detail (seed 003 Sec. 4.5-4.6).
 //!
+//! - `etopo-cube+detail`: the real thing, `pmc_dem::DemHeights::height_at_lattice` on the ETOPO60
+//!   fixture imported at data level 10 (1025 x 1025 samples a face, as ETOPO5's default import):
+//!   bicubic data through the tiled reader, relief weights, and the 4 detail octaves a level-14
+//!   vertex gets (the finer ones are exactly zero there).
+//!
 //! Seed 003 reports about 22 ms per patch for its sampling.
 use criterion::{criterion_group, criterion_main, Criterion};
 use pmc_density::noise::{Fbm, FbmParams};
@@ -72,6 +77,38 @@ impl LatticeHeights for DemHeights {
     }
 }
 
+/// A real elevation model's heights at lattice points.
+struct CubeHeights(pmc_dem::DemHeights);
+
+impl LatticeHeights for CubeHeights {
+    fn height(&self, lattice: IVec3, m: i32) -> f64 {
+        self.0.height_at_lattice(lattice, m)
+    }
+}
+
+fn etopo_cube() -> CubeHeights {
+    use pmc_dem::{import_cube, EquirectDem, ImportOptions};
+    let dir = std::env::temp_dir().join(format!("pmc-bench-heightfield-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../pmc-dem/tests/fixtures/etopo60.cdf");
+    let dem = EquirectDem::read_netcdf(&src, None).unwrap();
+    let out = dir.join("etopo.pmcdem");
+    let options = ImportOptions {
+        level: Some(10),
+        ..ImportOptions::default()
+    };
+    let report = import_cube(&dem, &out, &options, &|_, _| {}).unwrap();
+    let spec = pmc_density::terrain::DemSpec {
+        path: out.to_str().unwrap().into(),
+        digest: report.digest,
+        interpolation: pmc_density::terrain::Interpolation::Bicubic,
+        seed: 7,
+    };
+    let layout = pmc_density::presets::layout_for_radius(RADIUS).unwrap();
+    let cube = std::sync::Arc::new(pmc_dem::CubeDem::open(&out).unwrap());
+    CubeHeights(pmc_dem::dem_heights(cube, &spec, &layout).0)
+}
+
 fn heightfield(c: &mut Criterion) {
     let level = 14;
     let n = 1u32 << level;
@@ -90,6 +127,7 @@ fn heightfield(c: &mut Criterion) {
     bench("sphere", &ConstantHeight(0.0));
     bench("fbm8", &FbmHeights(Fbm::new(7, FbmParams::new(900.0, 8))));
     bench("dem2049+fbm4", &DemHeights::new());
+    bench("etopo-cube+detail", &etopo_cube());
     g.finish();
 }
 

@@ -2,7 +2,7 @@
 //! `pmc_server::flight`): a cold teleport to the ground, then a descent from orbit.
 
 use crate::error::CliError;
-use crate::planet_args::PlanetArgs;
+use crate::planet_args::{MesherName, PlanetArgs};
 use clap::Args;
 use pmc_server::flight::{descent, fly, FlightCamera, StopReport};
 use pmc_server::{AppState, ServerConfig};
@@ -26,6 +26,11 @@ pub struct FlightArgs {
     /// Worker threads generating chunks; 0 uses every core.
     #[arg(long, default_value_t = 0, value_name = "N")]
     threads: usize,
+
+    /// How the planet is meshed: volumetric (marching cubes: caves, overhangs, editing) or
+    /// heightfield (65 x 65 patches of six quadtrees, seed 003: elevation models only, no editing).
+    #[arg(long, value_enum, default_value = "volumetric")]
+    mesher: MesherName,
 
     /// Largest screen-space error, pixels.
     #[arg(long, default_value_t = 2.0, value_name = "PX")]
@@ -54,6 +59,7 @@ pub fn run(args: &FlightArgs) -> Result<(), CliError> {
     let config = ServerConfig {
         terrain,
         layout,
+        mesher: args.mesher.into(),
         threads: args.threads,
         ..ServerConfig::default()
     };

@@ -278,3 +278,21 @@ mod tests {
         assert!(layout(&["--radius", "abc"]).unwrap_err().contains("--radius"));
     }
 }
+
+/// The meshers, by their command-line names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MesherName {
+    /// Marching cubes in spherical space.
+    Volumetric,
+    /// The height-field quadtree of 65 x 65 patches.
+    Heightfield,
+}
+
+impl From<MesherName> for pmc_server::Mesher {
+    fn from(m: MesherName) -> Self {
+        match m {
+            MesherName::Volumetric => pmc_server::Mesher::Volumetric,
+            MesherName::Heightfield => pmc_server::Mesher::Heightfield,
+        }
+    }
+}

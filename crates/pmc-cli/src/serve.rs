@@ -2,7 +2,7 @@
 
 use crate::edit::WorldPlanetArgs;
 use crate::error::CliError;
-use crate::planet_args::PlanetArgs;
+use crate::planet_args::{MesherName, PlanetArgs};
 use clap::Args;
 use pmc_server::{EditLimits, Server, ServerConfig};
 use std::io::{IsTerminal, Write};
@@ -23,6 +23,11 @@ pub struct ServeArgs {
     /// Port to listen on; 0 picks a free one (the URL line says which).
     #[arg(long, default_value_t = 8080)]
     port: u16,
+
+    /// How the planet is meshed: volumetric (marching cubes: caves, overhangs, editing) or
+    /// heightfield (65 x 65 patches of six quadtrees, seed 003: elevation models only, no editing).
+    #[arg(long, value_enum, default_value = "volumetric")]
+    mesher: MesherName,
 
     /// Worker threads that generate chunks; 0 uses every core.
     #[arg(long, default_value_t = 0, value_name = "N")]
@@ -79,6 +84,7 @@ pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliErro
         port: args.port,
         terrain,
         layout,
+        mesher: args.mesher.into(),
         cache_bytes: args.cache_mb.saturating_mul(1 << 20),
         threads: args.threads,
         world: args.world.clone(),

@@ -56,6 +56,14 @@ impl DemHeights {
     pub fn dem(&self) -> &Arc<CubeDem> {
         &self.dem
     }
+
+    /// The height at the canonical lattice point `lattice` of resolution `m` (see
+    /// [`CubeDem::height_at_lattice`]): exact at data samples, with the detail octaves coarser
+    /// than the point's spacing. A pure, scale-invariant function of the point: what a
+    /// height-field mesher needs of its heights.
+    pub fn height_at_lattice(&self, lattice: pmc_geometry::glam::IVec3, m: i32) -> f64 {
+        self.dem.height_at_lattice(lattice, m, self.interpolation, &self.detail)
+    }
 }
 
 impl HeightField for DemHeights {

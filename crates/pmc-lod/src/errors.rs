@@ -116,6 +116,10 @@ const FORCED_AIR: f32 = -1.0;
 /// of the directions agree within 20%). At most `4 samples_per_level` directions are drawn per
 /// level. The result depends only on the planet, `samples_per_level` and `seed`.
 pub fn measure_level_errors(planet: &Planet, samples_per_level: usize, seed: u64) -> Vec<f64> {
+    if let Some(h) = planet.heightfield_mode() {
+        // Patches: the height-field's own measure (the same percentile, on its cells).
+        return h.level_errors().to_vec();
+    }
     let layout = *planet.layout();
     let max_level = layout.max_level();
     let mut errors = vec![0.0; usize::from(max_level) + 1];

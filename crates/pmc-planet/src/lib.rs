@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 
 mod cache;
+pub mod heightfield;
 mod planet;
 mod terrain;
 

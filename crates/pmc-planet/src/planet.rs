@@ -1,6 +1,7 @@
 //! The planet instance and its chunk pipeline.
 
 use crate::cache::{BaseCache, BaseCacheStats};
+use crate::heightfield::HeightfieldMode;
 use crate::terrain::{build_terrain, TerrainError};
 use pmc_density::presets::{self, PresetKind, Terrain};
 use pmc_density::terrain::TerrainSpec;
@@ -35,6 +36,8 @@ pub struct Planet {
     edited: Option<Arc<EditedDensity<Arc<dyn Density>>>>,
     /// Base density batches by chunk, shared by all clones (see [`Planet::with_base_cache`]).
     base_cache: Option<Arc<BaseCache>>,
+    /// Height-field meshing instead of marching cubes (see [`Planet::heightfield`]).
+    heightfield: Option<Arc<HeightfieldMode>>,
 }
 
 impl std::fmt::Debug for Planet {
@@ -158,7 +161,24 @@ impl Planet {
             density,
             edited: None,
             base_cache: None,
+            heightfield: None,
         }
+    }
+
+    /// The elevation model `spec` as a height-field planet (seed 003): its chunks are the 65 x 65
+    /// patches of six quadtrees on a patch layout (see [`crate::heightfield`]), shaded by the
+    /// model's volumetric terrain, whose density walking and probes use. Only elevation models
+    /// qualify; edits do not change the patches.
+    pub fn heightfield(spec: &TerrainSpec) -> Result<Planet, TerrainError> {
+        let (terrain, mode, layout) = crate::terrain::heightfield_parts(spec)?;
+        let mut planet = Planet::with_terrain(terrain, layout);
+        planet.heightfield = Some(Arc::new(mode));
+        Ok(planet)
+    }
+
+    /// The height-field meshing, for a planet made by [`Planet::heightfield`].
+    pub fn heightfield_mode(&self) -> Option<&HeightfieldMode> {
+        self.heightfield.as_deref()
     }
 
     /// This planet with a cache of the terrain's base density batches for up to `max_chunks`
@@ -302,6 +322,9 @@ impl Planet {
     /// Whether a chunk may hold surface, judged from the (edited) density's radial bounds and the
     /// shell boundary contract alone (no sampling).
     pub fn may_hold_surface(&self, key: &ChunkKey) -> bool {
+        if let Some(h) = &self.heightfield {
+            return h.patch_of(key).is_some();
+        }
         let span = i64::from(self.layout.n_t()) * key.stride();
         let k0 = i64::from(key.k) * span;
         let classify = |k: i64| -> Known {
@@ -333,6 +356,11 @@ impl Planet {
 
     /// The chunk pipeline, shading from `reuse` where it can.
     fn mesh_chunk(&self, key: ChunkKey, scratch: &mut ChunkScratch, out: &mut ChunkMesh, reuse: Option<Reuse>) {
+        if let Some(h) = &self.heightfield {
+            h.mesh(key, SideMask::NONE, out);
+            self.shade(out, None);
+            return;
+        }
         let grid = ChunkGrid::new(&self.layout, key);
         if !self.may_hold_surface(&key) {
             out.clear();
@@ -387,6 +415,11 @@ impl Planet {
         scratch: &mut ChunkScratch,
         out: &mut ChunkMesh,
     ) {
+        if let Some(h) = &self.heightfield {
+            h.mesh(key, coarser, out);
+            self.shade(out, None);
+            return;
+        }
         let grid = ChunkGrid::new(&self.layout, key);
         if !self.may_hold_surface(&key) {
             out.clear();

@@ -23,6 +23,14 @@ pub enum TerrainError {
         /// The digest of the file.
         found: String,
     },
+    /// A height-field planet was asked of a terrain that is no elevation model (presets have
+    /// caves and overhangs no height field can hold). Fix: give an elevation file, or mesh the
+    /// preset volumetrically.
+    #[error("only an elevation model can be meshed as a height field, not the preset {0}")]
+    NotHeightfield(String),
+    /// The patch layout of a height-field planet could not be made.
+    #[error("the height-field layout: {0}")]
+    Layout(#[from] pmc_geometry::LayoutError),
     /// The relief does not fit the layout's shell.
     #[error("{path}: {source}")]
     Relief {
@@ -63,4 +71,37 @@ pub fn default_layout(spec: &TerrainSpec) -> Result<Layout, TerrainError> {
         TerrainSpec::Preset { kind, .. } => Ok(kind.default_layout(None).expect("every preset has a default layout")),
         TerrainSpec::Dem(dem) => Ok(pmc_dem::dem_layout(dem)?),
     }
+}
+
+/// An elevation model's heights at lattice points, for the height-field mesher.
+struct DemLattice(pmc_dem::DemHeights);
+
+impl pmc_heightfield::LatticeHeights for DemLattice {
+    fn height(&self, lattice: pmc_geometry::glam::IVec3, m: i32) -> f64 {
+        self.0.height_at_lattice(lattice, m)
+    }
+}
+
+/// The terrain of the elevation model `spec` (on its own layout) and its height-field meshing
+/// (with the patch layout).
+pub(crate) fn heightfield_parts(
+    spec: &TerrainSpec,
+) -> Result<(Terrain, crate::heightfield::HeightfieldMode, Layout), TerrainError> {
+    let TerrainSpec::Dem(dem) = spec else {
+        return Err(TerrainError::NotHeightfield(spec.name()));
+    };
+    let layout = default_layout(spec)?;
+    let terrain = build_terrain(spec, &layout)?;
+    let cube = std::sync::Arc::new(pmc_dem::CubeDem::open(&dem.path)?);
+    let (heights, vertical) = pmc_dem::dem_heights(cube, dem, &layout);
+    let datum = terrain
+        .sea_radius
+        .unwrap_or_else(|| 0.5 * (layout.d_b() + layout.radius()));
+    let (lo, hi) = pmc_dem::HeightField::bounds(&heights);
+    let (mode, patch_layout) = crate::heightfield::HeightfieldMode::new(
+        std::sync::Arc::new(DemLattice(heights)),
+        datum,
+        (lo * vertical, hi * vertical),
+    )?;
+    Ok((terrain, mode, patch_layout))
 }

@@ -63,6 +63,20 @@ pub struct ServerConfig {
     /// Chunks whose base terrain samples the edited planet keeps to remesh edits fast (with a
     /// world; about 171 KB each at `n_t` 32).
     pub base_cache_chunks: usize,
+    /// How the default planet is meshed: marching cubes (caves, overhangs, editing) or, for an
+    /// elevation model, a height field of 65 x 65 patches (seed 003).
+    pub mesher: Mesher,
+}
+
+/// How a server meshes its planet.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Mesher {
+    /// Marching cubes in spherical space, with levels of detail (every terrain; editable).
+    #[default]
+    Volumetric,
+    /// The height-field quadtree of 65 x 65 patches (elevation models only; not editable). The
+    /// planet's layout becomes its patch layout (`pmc_planet::heightfield`).
+    Heightfield,
 }
 
 impl Default for ServerConfig {
@@ -79,6 +93,7 @@ impl Default for ServerConfig {
             world: None,
             edit_limits: EditLimits::default(),
             base_cache_chunks: 256,
+            mesher: Mesher::Volumetric,
         }
     }
 }
@@ -93,6 +108,20 @@ impl ServerConfig {
             return Err(ServerError::Config(
                 "queue_limit must be at least 1 (jobs waiting for a worker)".into(),
             ));
+        }
+        if self.mesher == Mesher::Heightfield {
+            if !matches!(self.terrain, TerrainSpec::Dem(_)) {
+                return Err(ServerError::Config(format!(
+                    "--mesher heightfield meshes elevation models only (give --dem FILE), not the preset {}",
+                    self.terrain.name()
+                )));
+            }
+            if self.world.is_some() {
+                return Err(ServerError::Config(
+                    "a height field cannot be edited: serve a world with the volumetric mesher (leave --mesher out)"
+                        .into(),
+                ));
+            }
         }
         let e = &self.edit_limits;
         if !(e.min_brush_radius > 0.0 && e.min_brush_radius <= e.max_brush_radius) {

@@ -39,7 +39,7 @@ mod rate;
 mod server;
 mod state;
 
-pub use config::{EditLimits, ServerConfig};
+pub use config::{EditLimits, Mesher, ServerConfig};
 pub use error::ServerError;
 pub use server::{router, serve, shutdown_signal, Server};
 pub use state::{AppState, Stats};

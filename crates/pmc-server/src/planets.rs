@@ -10,15 +10,18 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 pub(crate) struct Planets {
     layout: Layout,
     max: usize,
+    /// The only planet served, already built (a height-field planet, whose layout is its own).
+    pinned: Option<(PlanetId, Planet)>,
     list: Mutex<VecDeque<(PlanetId, Arc<Planet>)>>,
 }
 
 impl Planets {
     /// An empty set of at most `max` planets.
-    pub fn new(layout: Layout, max: usize) -> Planets {
+    pub fn new(layout: Layout, max: usize, pinned: Option<(PlanetId, Planet)>) -> Planets {
         Planets {
             layout,
             max: max.max(1),
+            pinned,
             list: Mutex::new(VecDeque::new()),
         }
     }
@@ -39,6 +42,16 @@ impl Planets {
 
     /// Builds planet `id` (the caller runs this off the async runtime).
     pub fn build(&self, id: &PlanetId) -> Result<Planet, String> {
+        if let Some((pinned, planet)) = &self.pinned {
+            return if pinned == id {
+                Ok(planet.clone())
+            } else {
+                Err(format!(
+                    "this server meshes {} as a height field and serves no other planet",
+                    pinned.name()
+                ))
+            };
+        }
         Planet::from_terrain(id, self.layout).map_err(|e| e.to_string())
     }
 

@@ -148,6 +148,16 @@ impl AppState {
                 Some(Arc::new(editing))
             }
         };
+        // A height-field planet brings its own (patch) layout: built now, kept as the server's.
+        let heightfield = match config.mesher {
+            crate::config::Mesher::Heightfield => {
+                let planet =
+                    pmc_planet::Planet::heightfield(&config.terrain).map_err(|e| ServerError::Config(e.to_string()))?;
+                config.layout = *planet.layout();
+                Some(planet)
+            }
+            crate::config::Mesher::Volumetric => None,
+        };
         let generator = Generator::new(config.threads, config.queue_limit, config.cache_bytes).map_err(|reason| {
             ServerError::Threads {
                 threads: config.threads,
@@ -156,7 +166,11 @@ impl AppState {
         })?;
         Ok(AppState {
             inner: Arc::new(Inner {
-                planets: Planets::new(config.layout, config.max_planets),
+                planets: Planets::new(
+                    config.layout,
+                    config.max_planets,
+                    heightfield.map(|p| (Arc::new(config.terrain.clone()), p)),
+                ),
                 generator: Arc::new(generator),
                 editing,
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
