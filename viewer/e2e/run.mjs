@@ -1081,7 +1081,7 @@ async function main() {
     };
     // the Himalaya from orbit, and a coast from 30 km: the pictures are the README's
     await hook(() => window.__pmc.mode('orbit'));
-    await look('dem-himalaya-orbit', 27, 86, 6_000_000, -90);
+    await look('dem-himalaya-orbit', 29, 86, 2_500_000, -90);
     await hook(() => window.__pmc.mode('fly'));
     await look('dem-coast', 35.55, -5.6, 30_000, -35);
     // a cave dug under a mountain of the Alps, seen from 25 m above the ground a little south of

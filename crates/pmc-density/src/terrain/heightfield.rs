@@ -44,8 +44,9 @@ const CAVE: u8 = 7;
 
 /// Depth (true-scale metres) above which the seabed is shelf, below which it is deep ocean.
 pub const SHELF_DEPTH: f64 = 200.0;
-/// Snow line at the equator (true-scale metres), falling towards the poles.
-const SNOW_LINE: f64 = 5000.0;
+/// Snow line at the equator (true-scale metres), falling towards the poles as `1 - sin^4(lat)`
+/// (about 5 200 m at 30 degrees, 2 400 m at 60, sea level at the poles).
+const SNOW_LINE: f64 = 5500.0;
 /// Tree line, as a fraction of the snow line.
 const TREE_LINE: f64 = 0.7;
 
@@ -260,7 +261,8 @@ impl HeightShader {
             };
         }
         let up = normal.dot(dir);
-        let snow = SNOW_LINE * (1.0 - dir.y * dir.y).powf(1.5);
+        let y2 = dir.y * dir.y;
+        let snow = SNOW_LINE * (1.0 - y2 * y2);
         if zt > snow && up > 0.5 {
             return SNOW;
         }
