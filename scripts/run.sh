@@ -4,6 +4,7 @@
 # (created on first run; delete it to start over). Arguments replace that and go to `pmc serve`:
 #   ./scripts/run.sh --preset mars --seed 3 --port 9000
 #   ./scripts/run.sh --world my.pmcw
+#   ./scripts/run.sh --dem earth.pmcdem    (a real planet: see pmc dem import)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -51,6 +51,13 @@ fn named(e: &crate::DemError) {
     assert!(e.to_string().starts_with("fuzz: "));
 }
 
+/// An error about the file at `path` names it.
+fn named_path(e: &crate::DemError, path: &Path) {
+    let file = path.display().to_string();
+    assert_eq!(e.file(), file);
+    assert!(e.to_string().starts_with(&file));
+}
+
 /// Checks a grid read in memory.
 fn consistent(dem: &EquirectDem) {
     let (w, h) = (dem.width(), dem.height());
@@ -144,6 +151,62 @@ fn parse_png(bytes: &[u8]) -> bool {
     }
 }
 
+thread_local! {
+    /// Where this thread writes a `.pmcdem` input (the reader opens files, not bytes).
+    static PMCDEM_PATH: PathBuf = std::env::temp_dir().join(format!(
+        "pmc-dem-fuzz-{}-{:?}.pmcdem",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+}
+
+fn parse_pmcdem(bytes: &[u8]) -> bool {
+    PMCDEM_PATH.with(|path| {
+        if std::fs::write(path, bytes).is_err() {
+            return false;
+        }
+        let accepted = match crate::CubeDem::open_with_cache(path, 1 << 20) {
+            Ok(dem) => {
+                // Heights anywhere must not panic, whatever the tiles hold; a damaged tile is
+                // found by verify.
+                let detail = crate::DetailNoise::default();
+                for d in [pmc_geometry::glam::DVec3::Y, pmc_geometry::glam::DVec3::new(0.3, -0.2, 0.9)] {
+                    let _ = dem.height(d, crate::Interpolation::Bicubic, &detail, 1.0);
+                }
+                match dem.verify() {
+                    Ok(()) => true,
+                    Err(e) => {
+                        named_path(&e, path);
+                        false
+                    }
+                }
+            }
+            Err(e) => {
+                named_path(&e, path);
+                false
+            }
+        };
+        let _ = std::fs::remove_file(path);
+        accepted
+    })
+}
+
+/// A small `.pmcdem` made from the ETOPO60 seed (data level 6, 16-sample tiles): the bytes of an
+/// import, the same every time.
+fn pmcdem_seed(fixtures: &Path) -> std::io::Result<Vec<u8>> {
+    let src = EquirectDem::read_netcdf(fixtures.join(SEED_FILES[0]), None).map_err(std::io::Error::other)?;
+    let out = std::env::temp_dir().join(format!("pmc-dem-fuzz-seed-{}.pmcdem", std::process::id()));
+    let options = crate::ImportOptions {
+        level: Some(6),
+        tile_size: 16,
+        ..crate::ImportOptions::default()
+    };
+    crate::import_cube(&src, &out, &options, &|_, _| {}).map_err(std::io::Error::other)?;
+    let bytes = std::fs::read(&out);
+    let _ = std::fs::remove_file(&out);
+    bytes
+}
+
 /// Every reader, with the seed files read from `fixtures` (the crate's `tests/fixtures`): the
 /// netCDF reader whole and windowed on ETOPO60; the GeoTIFF reader whole on strips compressed
 /// with deflate and LZW and on tiles, and windowed on the tiles; the PNG reader.
@@ -186,6 +249,11 @@ pub fn targets(fixtures: &Path) -> std::io::Result<Vec<Target>> {
             name: "png16",
             seed: read(SEED_FILES[4])?,
             parse: parse_png,
+        },
+        Target {
+            name: "pmcdem",
+            seed: pmcdem_seed(fixtures)?,
+            parse: parse_pmcdem,
         },
     ])
 }
