@@ -1009,7 +1009,7 @@ async function main() {
     await server.stop();
   });
 
-  await step('11. a real planet from an elevation model: imported, seen from orbit and near the ground with no crack or hole, land, shelf and deep ocean told apart, a cave dug under a mountain', async () => {
+  await step('11. a real planet from an elevation model: imported, seen from orbit and near the ground with no crack or hole, land, shelf and deep ocean told apart, a cave dug under a mountain; the same model as a height field', async () => {
     // PMC_E2E_DEM: another equirectangular model to fly over (the README's pictures are taken
     // over ETOPO5); by default the one-degree ETOPO60 fixture of pmc-dem's tests
     const source = process.env.PMC_E2E_DEM ? resolve(process.env.PMC_E2E_DEM) : resolve(viewerDir, '../crates/pmc-dem/tests/fixtures/etopo60.cdf');
@@ -1110,6 +1110,21 @@ async function main() {
     check(consoleProblems.length === 0 && failedResponses.length === 0, `${[...consoleProblems, ...failedResponses].join('\n  ')}`);
     await page.goto('about:blank');
     await server.stop();
+    // the same model as a height field (--mesher heightfield): 65 x 65 patches streamed as
+    // chunks, drawn with no crack or hole from orbit and from 200 km
+    const patches = await startBackend(null, { extra: ['--dem', dem, '--mesher', 'heightfield'] });
+    await page.goto(`${patches.url}#mode=orbit&lat=28&lon=86.9`, { waitUntil: 'load', timeout: 60_000 });
+    await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+    await ready('the height field from orbit');
+    const hp = await hook(() => fetch('api/v1/planet').then((x) => x.json()));
+    check(hp.layout.n_t === 64 && hp.layout.d_c === 1, `the height field's layout is ${JSON.stringify(hp.layout)}`);
+    await hook(() => window.__pmc.mode('orbit'));
+    await look('dem-heightfield-orbit', 28, 86.9, 6_000_000, -90);
+    await hook(() => window.__pmc.mode('fly'));
+    await look('dem-heightfield-200km', 26, 86.9, 200_000, -35);
+    check(consoleProblems.length === 0 && failedResponses.length === 0, `${[...consoleProblems, ...failedResponses].join('\n  ')}`);
+    await page.goto('about:blank');
+    await patches.stop();
   });
 }
 
