@@ -170,7 +170,10 @@ fn parse_pmcdem(bytes: &[u8]) -> bool {
                 // Heights anywhere must not panic, whatever the tiles hold; a damaged tile is
                 // found by verify.
                 let detail = crate::DetailNoise::default();
-                for d in [pmc_geometry::glam::DVec3::Y, pmc_geometry::glam::DVec3::new(0.3, -0.2, 0.9)] {
+                for d in [
+                    pmc_geometry::glam::DVec3::Y,
+                    pmc_geometry::glam::DVec3::new(0.3, -0.2, 0.9),
+                ] {
                     let _ = dem.height(d, crate::Interpolation::Bicubic, &detail, 1.0);
                 }
                 match dem.verify() {

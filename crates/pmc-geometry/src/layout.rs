@@ -283,22 +283,7 @@ impl Layout {
             return None;
         }
         // Unfold as `lattice` does, with doubled indices: the lattice point in quarter steps.
-        let fr = face.frame();
-        let fold = |x: i64| -> Option<(i64, i64)> {
-            if x < -n2 || x > 2 * n2 {
-                None
-            } else if x > n2 {
-                Some((n2, x - n2))
-            } else if x < 0 {
-                Some((-n2, -x))
-            } else {
-                Some((2 * x - n2, 0))
-            }
-        };
-        let (cu, eu) = fold(ci)?;
-        let (cv, ev) = fold(cj)?;
-        let cn = n2 - 2 * (eu + ev);
-        let p = fr.n.as_i64vec3() * cn + fr.u.as_i64vec3() * cu + fr.v.as_i64vec3() * cv;
+        let p = face_lattice(face, ci, cj, n2)?.as_i64vec3();
         let other = Face::ALL.into_iter().find(|f| f.frame().n.as_i64vec3().dot(p) == n2)?;
         let ofr = other.frame();
         Some((
@@ -332,30 +317,7 @@ impl Layout {
     /// chunk padding reaches across face edges. Returns `None` when both indices are out of range
     /// (there is no such point next to a cube corner) or when one is too far out.
     pub fn lattice(&self, face: Face, i: i64, j: i64) -> Option<IVec3> {
-        let n = self.face_tiles();
-        let out_i = !(0..=n).contains(&i);
-        let out_j = !(0..=n).contains(&j);
-        if out_i && out_j {
-            return None;
-        }
-        let fr = face.frame();
-        // Components along u and v in half grid steps, and the excess past the face.
-        let fold = |x: i64| -> Option<(i64, i64)> {
-            if x < -n || x > 2 * n {
-                None
-            } else if x > n {
-                Some((n, x - n))
-            } else if x < 0 {
-                Some((-n, -x))
-            } else {
-                Some((2 * x - n, 0))
-            }
-        };
-        let (cu, eu) = fold(i)?;
-        let (cv, ev) = fold(j)?;
-        let cn = n - 2 * (eu + ev);
-        let p = fr.n.as_i64vec3() * cn + fr.u.as_i64vec3() * cu + fr.v.as_i64vec3() * cv;
-        Some(p.as_ivec3())
+        face_lattice(face, i, j, self.face_tiles())
     }
 
     /// The canonical key of voxel `(i, j, k)` of `face` (see [`Layout::lattice`] for the range).
@@ -585,4 +547,38 @@ mod level_tests {
             }
         }
     }
+}
+
+/// The canonical lattice point of face grid index `(i, j)` at resolution `m` (grid steps per face
+/// side): `m n + (2i - m) u + (2j - m) v` in the face's frame, every component in `[-m, m]`.
+///
+/// Indices in `0..=m` lie on `face`. An index up to `m` past one side (the other in range) lies on
+/// the neighbouring face, unfolded about the shared edge as in Algorithm 1 (seed 000): this is how
+/// chunk padding, height-field borders and bicubic stencils reach across face edges. Returns
+/// `None` when both indices are out of range (there is no such point next to a cube corner) or
+/// when one is more than `m` out. [`Layout::lattice`] is this at `m = n_c n_t`.
+pub fn face_lattice(face: Face, i: i64, j: i64, m: i64) -> Option<IVec3> {
+    let out_i = !(0..=m).contains(&i);
+    let out_j = !(0..=m).contains(&j);
+    if out_i && out_j {
+        return None;
+    }
+    let fr = face.frame();
+    // Components along u and v in half grid steps, and the excess past the face.
+    let fold = |x: i64| -> Option<(i64, i64)> {
+        if x < -m || x > 2 * m {
+            None
+        } else if x > m {
+            Some((m, x - m))
+        } else if x < 0 {
+            Some((-m, -x))
+        } else {
+            Some((2 * x - m, 0))
+        }
+    };
+    let (cu, eu) = fold(i)?;
+    let (cv, ev) = fold(j)?;
+    let cn = m - 2 * (eu + ev);
+    let p = fr.n.as_i64vec3() * cn + fr.u.as_i64vec3() * cu + fr.v.as_i64vec3() * cv;
+    Some(p.as_ivec3())
 }

@@ -23,37 +23,7 @@ pub fn resolution(level: u8) -> i64 {
     i64::from(PATCH_SEGMENTS) << level
 }
 
-/// The canonical lattice point of face grid index `(i, j)` at resolution `m` (segments per face
-/// side): `m n + (2i - m) u + (2j - m) v` in the face's frame, every component in `[-m, m]`.
-///
-/// Indices in `0..=m` lie on `face`; an index up to `m` past one side (the other in range) lies on
-/// the neighbouring face, unfolded about the shared edge as Algorithm 1 does (the same rule as
-/// [`pmc_geometry::Layout::lattice`], for any resolution). Returns `None` when both indices are
-/// out of range (no such point next to a cube corner) or one is more than `m` out.
-pub fn face_lattice(face: Face, i: i64, j: i64, m: i64) -> Option<IVec3> {
-    let out_i = !(0..=m).contains(&i);
-    let out_j = !(0..=m).contains(&j);
-    if out_i && out_j {
-        return None;
-    }
-    let fold = |x: i64| -> Option<(i64, i64)> {
-        if x < -m || x > 2 * m {
-            None
-        } else if x > m {
-            Some((m, x - m))
-        } else if x < 0 {
-            Some((-m, -x))
-        } else {
-            Some((2 * x - m, 0))
-        }
-    };
-    let (cu, eu) = fold(i)?;
-    let (cv, ev) = fold(j)?;
-    let cn = m - 2 * (eu + ev);
-    let fr = face.frame();
-    let p = fr.n.as_i64vec3() * cn + fr.u.as_i64vec3() * cu + fr.v.as_i64vec3() * cv;
-    Some(p.as_ivec3())
-}
+pub use pmc_geometry::face_lattice;
 
 /// The unit direction of lattice point `lattice` at resolution `m`: `cube_to_sphere(lattice / m)`.
 ///

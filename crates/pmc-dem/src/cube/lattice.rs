@@ -31,26 +31,7 @@ pub(crate) fn indices_on(face: Face, p: IVec3, r: i32) -> (i32, i32) {
 /// (unfolded onto the neighbouring face about the shared edge, Algorithm 1); `None` when both
 /// indices are out of range. The same unfolding as `pmc_geometry::Layout::lattice`.
 pub(crate) fn unfold(face: Face, r: i32, i: i32, j: i32) -> Option<IVec3> {
-    let out_i = !(0..=r).contains(&i);
-    let out_j = !(0..=r).contains(&j);
-    if out_i && out_j {
-        return None;
-    }
-    let fold = |x: i32| -> Option<(i32, i32)> {
-        if x < -r || x > 2 * r {
-            None
-        } else if x > r {
-            Some((r, x - r))
-        } else if x < 0 {
-            Some((-r, -x))
-        } else {
-            Some((2 * x - r, 0))
-        }
-    };
-    let (cu, eu) = fold(i)?;
-    let (cv, ev) = fold(j)?;
-    let f = face.frame();
-    Some(f.n * (r - 2 * (eu + ev)) + f.u * cu + f.v * cv)
+    pmc_geometry::face_lattice(face, i64::from(i), i64::from(j), i64::from(r))
 }
 
 #[cfg(test)]
