@@ -84,6 +84,10 @@ impl LatticeHeights for CubeHeights {
     fn height(&self, lattice: IVec3, m: i32) -> f64 {
         self.0.height_at_lattice(lattice, m)
     }
+
+    fn heights(&self, points: &[IVec3], m: i32, out: &mut [f64]) {
+        self.0.heights_at_lattice(points, m, out)
+    }
 }
 
 fn etopo_cube() -> CubeHeights {

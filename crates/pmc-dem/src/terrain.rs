@@ -64,6 +64,13 @@ impl DemHeights {
     pub fn height_at_lattice(&self, lattice: pmc_geometry::glam::IVec3, m: i32) -> f64 {
         self.dem.height_at_lattice(lattice, m, self.interpolation, &self.detail)
     }
+
+    /// [`DemHeights::height_at_lattice`] of many points of one resolution, with the same bits
+    /// (see [`CubeDem::heights_at_lattice`]).
+    pub fn heights_at_lattice(&self, points: &[pmc_geometry::glam::IVec3], m: i32, out: &mut [f64]) {
+        self.dem
+            .heights_at_lattice(points, m, self.interpolation, &self.detail, out)
+    }
 }
 
 impl HeightField for DemHeights {

@@ -80,6 +80,10 @@ impl pmc_heightfield::LatticeHeights for DemLattice {
     fn height(&self, lattice: pmc_geometry::glam::IVec3, m: i32) -> f64 {
         self.0.height_at_lattice(lattice, m)
     }
+
+    fn heights(&self, points: &[pmc_geometry::glam::IVec3], m: i32, out: &mut [f64]) {
+        self.0.heights_at_lattice(points, m, out)
+    }
 }
 
 /// The terrain of the elevation model `spec` (on its own layout) and its height-field meshing

@@ -8,6 +8,15 @@ use pmc_geometry::{face_uv_to_cube, sphere_to_face_uv, Face};
 
 pub use pmc_density::terrain::Interpolation;
 
+/// The relief weight at `(fs, ft)` in a cell from its corners' weights, bilinearly.
+#[inline]
+fn lerp_reliefs(r: &[f64; 4], fs: f64, ft: f64) -> f64 {
+    let (a, bb, c, d) = (r[0], r[1], r[2], r[3]);
+    let lo = a + fs * (bb - a);
+    let hi = c + fs * (d - c);
+    lo + ft * (hi - lo)
+}
+
 /// The largest lattice resolution [`CubeDem::height_at_lattice`] accepts: `2^30`.
 pub const MAX_LATTICE_RESOLUTION: i32 = 1 << 30;
 
@@ -123,7 +132,16 @@ impl CubeDem {
         interp: Interpolation,
         detail: &DetailNoise,
     ) -> (f64, f64) {
-        let value = match interp {
+        let value = self.block_value(b, fs, ft, interp);
+        if !detail.is_on() {
+            return (value, 1.0);
+        }
+        (value, lerp_reliefs(&self.block_reliefs(b, detail), fs, ft))
+    }
+
+    /// The interpolated data at `(fs, ft)` within the middle cell of a 4 x 4 block.
+    fn block_value(&self, b: &[f64; 16], fs: f64, ft: f64, interp: Interpolation) -> f64 {
+        match interp {
             Interpolation::Bilinear => {
                 let (a, bb, c, d) = (b[5], b[6], b[9], b[10]);
                 let lo = a + fs * (bb - a);
@@ -140,11 +158,11 @@ impl CubeDem {
                 }
                 total.clamp(self.header.min, self.header.max)
             }
-        };
-        if !detail.is_on() {
-            return (value, 1.0);
         }
-        // The relief weight of a sample from its four neighbours, in `relief`'s order.
+    }
+
+    /// The relief weights of the middle cell's four corners (in `relief`'s order of neighbours).
+    fn block_reliefs(&self, b: &[f64; 16], detail: &DetailNoise) -> [f64; 4] {
         let relief = |x: usize, y: usize| -> f64 {
             let h = b[y * 4 + x];
             let mut most = 0.0f64;
@@ -161,24 +179,28 @@ impl CubeDem {
             }
             detail.relief_weight(most, self.data_spacing())
         };
-        let (a, bb, c, d) = (relief(1, 1), relief(2, 1), relief(1, 2), relief(2, 2));
-        let lo = a + fs * (bb - a);
-        let hi = c + fs * (d - c);
-        (value, lo + ft * (hi - lo))
+        [relief(1, 1), relief(2, 1), relief(1, 2), relief(2, 2)]
+    }
+
+    /// The cell of fractional sample indices `(s, t)`: its lower corner and the fractions.
+    fn cell(&self, s: f64, t: f64) -> Option<(i32, i32, f64, f64)> {
+        let r = 1i32 << self.header.n;
+        let rf = f64::from(r);
+        if !(s.is_finite() && t.is_finite()) {
+            return None;
+        }
+        let (s, t) = (s.clamp(0.0, rf), t.clamp(0.0, rf));
+        let i0 = (s.floor() as i32).min(r - 1);
+        let j0 = (t.floor() as i32).min(r - 1);
+        Some((i0, j0, s - f64::from(i0), t - f64::from(j0)))
     }
 
     /// Interpolated data at fractional sample indices `(s, t)` of `face`, and the relief weight
     /// of the detail there (1 when the detail is off).
     fn interpolate(&self, face: Face, s: f64, t: f64, interp: Interpolation, detail: &DetailNoise) -> (f64, f64) {
-        let r = 1i32 << self.header.n;
-        let rf = f64::from(r);
-        if !(s.is_finite() && t.is_finite()) {
+        let Some((i0, j0, fs, ft)) = self.cell(s, t) else {
             return (f64::NAN, f64::NAN);
-        }
-        let (s, t) = (s.clamp(0.0, rf), t.clamp(0.0, rf));
-        let i0 = (s.floor() as i32).min(r - 1);
-        let j0 = (t.floor() as i32).min(r - 1);
-        let (fs, ft) = (s - f64::from(i0), t - f64::from(j0));
+        };
         if let Some(b) = self.block(face, i0, j0) {
             return self.interpolate_block(&b, fs, ft, interp, detail);
         }
@@ -290,6 +312,77 @@ impl CubeDem {
         value + weight * detail.sum(lattice.as_dvec3() * scale, octaves, self.data_spacing())
     }
 
+    /// [`CubeDem::height_at_lattice`] for every point of `points` (one resolution `m`) into `out`,
+    /// with the same bits: points that share a data cell (a height-field patch's thousands of
+    /// vertices lie in a few dozen) share one read of its 4 x 4 samples and their relief weights.
+    ///
+    /// Panics when `out` and `points` differ in length (a caller's bug).
+    pub fn heights_at_lattice(
+        &self,
+        points: &[IVec3],
+        m: i32,
+        interp: Interpolation,
+        detail: &DetailNoise,
+        out: &mut [f64],
+    ) {
+        assert_eq!(points.len(), out.len(), "one output per point");
+        let n = self.header.n;
+        let big_n = 1i32 << n;
+        let fine = m > big_n && m <= MAX_LATTICE_RESOLUTION && m.count_ones() == 1;
+        // The cells seen, with their samples and relief weights (None: near an edge or a tile
+        // border, computed point by point).
+        type Cell = ((Face, i32, i32), Option<([f64; 16], [f64; 4])>);
+        let mut cells: Vec<Cell> = Vec::new();
+        let mut last = 0usize;
+        for (lattice, h) in points.iter().zip(out.iter_mut()) {
+            let valid = lattice.abs().max_element() <= m && (*lattice + IVec3::splat(m)) % 2 == IVec3::ZERO;
+            let face = if fine && valid { home_face(*lattice, m) } else { None };
+            let Some(face) = face else {
+                *h = self.height_at_lattice(*lattice, m, interp, detail);
+                continue;
+            };
+            let scale = f64::from(big_n) / (2.0 * f64::from(m));
+            let fr = face.frame();
+            let s = f64::from(fr.u.dot(*lattice) + m) * scale;
+            let t = f64::from(fr.v.dot(*lattice) + m) * scale;
+            let Some((i0, j0, fs, ft)) = self.cell(s, t) else {
+                *h = f64::NAN;
+                continue;
+            };
+            let key = (face, i0, j0);
+            if cells.get(last).is_none_or(|c| c.0 != key) {
+                last = match cells.iter().position(|c| c.0 == key) {
+                    Some(at) => at,
+                    None => {
+                        let block = self.block(face, i0, j0).map(|b| {
+                            let r = if detail.is_on() {
+                                self.block_reliefs(&b, detail)
+                            } else {
+                                [1.0; 4]
+                            };
+                            (b, r)
+                        });
+                        cells.push((key, block));
+                        cells.len() - 1
+                    }
+                };
+            }
+            let (value, weight) = match &cells[last].1 {
+                Some((b, r)) => {
+                    let value = self.block_value(b, fs, ft, interp);
+                    (value, if detail.is_on() { lerp_reliefs(r, fs, ft) } else { 1.0 })
+                }
+                None => self.interpolate_samples(face, i0, j0, fs, ft, interp, detail),
+            };
+            *h = if detail.is_on() {
+                let octaves = m.trailing_zeros() - n;
+                value + weight * detail.sum(lattice.as_dvec3() * scale, octaves, self.data_spacing())
+            } else {
+                value
+            };
+        }
+    }
+
     /// The height, in metres, in direction `dir` (any length), with detail octaves down to a
     /// lattice spacing of `finest_spacing_m` metres (0 or less: all
     /// [`MAX_DETAIL_OCTAVES`](crate::cube::MAX_DETAIL_OCTAVES)). Agrees with
@@ -358,6 +451,32 @@ mod tests {
             }
         }
         assert!(blocks > 1000, "{blocks}");
+        // Whole batches of lattice points (patch-like grids over face edges, corners and tile
+        // borders, at several resolutions) give the bits of one point at a time.
+        for m in [64, 128, 512, 4096, 1 << 16] {
+            for face in Face::ALL {
+                let mut points = Vec::new();
+                let step = (m / 64).max(1);
+                for a in (0..=m).step_by(step as usize).take(70) {
+                    for b in [0, 1, m / 3, m - 1, m] {
+                        if let Some(p) = pmc_geometry::face_lattice(face, i64::from(a), i64::from(b), i64::from(m)) {
+                            points.push(p);
+                        }
+                    }
+                }
+                points.push(IVec3::new(m + 2, 0, 0)); // off the cube: NaN either way
+                for interp in [Interpolation::Bilinear, Interpolation::Bicubic] {
+                    for detail in [DetailNoise::default(), DetailNoise::OFF] {
+                        let mut batch = vec![0.0; points.len()];
+                        cube.heights_at_lattice(&points, m, interp, &detail, &mut batch);
+                        for (p, h) in points.iter().zip(&batch) {
+                            let one = cube.height_at_lattice(*p, m, interp, &detail);
+                            assert_eq!(h.to_bits(), one.to_bits(), "{face:?} {p} at {m}: {h} vs {one}");
+                        }
+                    }
+                }
+            }
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
