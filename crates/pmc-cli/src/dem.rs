@@ -340,10 +340,14 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Bytes in KB, MB or GB (powers of 1000, as seed 003 Fig. 13 prints them).
+/// Bytes in KB, MB, GB, TB or PB (powers of 1000, as seed 003 Fig. 13 prints them).
 fn human(b: u64) -> String {
     let b = b as f64;
-    if b >= 1e9 {
+    if b >= 1e15 {
+        format!("{:.1} PB", b / 1e15)
+    } else if b >= 1e12 {
+        format!("{:.1} TB", b / 1e12)
+    } else if b >= 1e9 {
         format!("{:.1} GB", b / 1e9)
     } else if b >= 1e6 {
         format!("{:.1} MB", b / 1e6)
