@@ -198,7 +198,10 @@ fn parse_pmcdem(bytes: &[u8]) -> bool {
 /// import, the same every time.
 fn pmcdem_seed(fixtures: &Path) -> std::io::Result<Vec<u8>> {
     let src = EquirectDem::read_netcdf(fixtures.join(SEED_FILES[0]), None).map_err(std::io::Error::other)?;
-    let out = std::env::temp_dir().join(format!("pmc-dem-fuzz-seed-{}.pmcdem", std::process::id()));
+    // A name of this call alone: tests build their targets concurrently.
+    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let out = std::env::temp_dir().join(format!("pmc-dem-fuzz-seed-{}-{call}.pmcdem", std::process::id()));
     let options = crate::ImportOptions {
         level: Some(6),
         tile_size: 16,
