@@ -3,8 +3,8 @@
 use crate::axis::{self, Regular, EVEN_TOLERANCE};
 use crate::dem::EquirectDem;
 use crate::error::DemError;
-use crate::netcdf_source::check_request;
 use crate::read::{self, Layout, MAX_CELLS};
+use crate::source::check_request;
 use crate::source::EquirectSource;
 use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::path::Path;

@@ -4,6 +4,7 @@ use crate::axis::Regular;
 use crate::error::DemError;
 use crate::header::HeaderInfo;
 use crate::read::{self, Layout, Prepared, Values};
+use crate::source::check_request;
 use crate::source::EquirectSource;
 use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::path::Path;
@@ -240,31 +241,4 @@ impl EquirectSource for NetcdfSource {
         }
         Ok(())
     }
-}
-
-/// Refuses a request for rows past the grid or a buffer of the wrong size.
-pub(crate) fn check_request(
-    file: &str,
-    width: usize,
-    height: usize,
-    row0: usize,
-    rows: usize,
-    out_len: usize,
-) -> Result<(), DemError> {
-    if row0.checked_add(rows).is_none_or(|end| end > height) {
-        return Err(DemError::OutOfGrid {
-            file: file.to_owned(),
-            detail: format!(
-                "rows {row0}..{} asked of a grid of {height} rows",
-                row0.saturating_add(rows)
-            ),
-        });
-    }
-    if rows.checked_mul(width) != Some(out_len) {
-        return Err(DemError::OutOfGrid {
-            file: file.to_owned(),
-            detail: format!("a buffer of {out_len} heights given for {rows} rows of {width}"),
-        });
-    }
-    Ok(())
 }

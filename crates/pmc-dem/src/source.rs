@@ -60,26 +60,37 @@ impl EquirectSource for EquirectDem {
     }
     fn read_rows(&self, row0: usize, rows: usize, out: &mut [f32]) -> Result<(), DemError> {
         let w = self.width;
-        let end = row0.checked_add(rows).filter(|&e| e <= self.height);
-        let Some(end) = end else {
-            return Err(DemError::OutOfGrid {
-                file: self.source.clone(),
-                detail: format!(
-                    "rows {row0}..{} asked of a grid of {} rows",
-                    row0.saturating_add(rows),
-                    self.height
-                ),
-            });
-        };
-        if out.len() != rows * w {
-            return Err(DemError::OutOfGrid {
-                file: self.source.clone(),
-                detail: format!("a buffer of {} heights given for {rows} rows of {w}", out.len()),
-            });
-        }
-        out.copy_from_slice(&self.heights[row0 * w..end * w]);
+        check_request(&self.source, w, self.height, row0, rows, out.len())?;
+        out.copy_from_slice(&self.heights[row0 * w..(row0 + rows) * w]);
         Ok(())
     }
+}
+
+/// Refuses a request for rows past the grid or a buffer of the wrong size.
+pub(crate) fn check_request(
+    file: &str,
+    width: usize,
+    height: usize,
+    row0: usize,
+    rows: usize,
+    out_len: usize,
+) -> Result<(), DemError> {
+    if row0.checked_add(rows).is_none_or(|end| end > height) {
+        return Err(DemError::OutOfGrid {
+            file: file.to_owned(),
+            detail: format!(
+                "rows {row0}..{} asked of a grid of {height} rows",
+                row0.saturating_add(rows)
+            ),
+        });
+    }
+    if rows.checked_mul(width) != Some(out_len) {
+        return Err(DemError::OutOfGrid {
+            file: file.to_owned(),
+            detail: format!("a buffer of {out_len} heights given for {rows} rows of {width}"),
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
