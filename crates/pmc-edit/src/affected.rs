@@ -3,7 +3,8 @@
 //! A chunk's mesh is a function of its padded samples alone (its `(n_t + 1)^3` voxels plus the one
 //! layer of padding its normals read), and an operation changes a sample only strictly inside its
 //! [`BrushOp::reach`]. So the chunks to remesh are those whose padded samples can lie in that
-//! ball. (Radial bounds widen with edits too, but a chunk skipped before an edit held only solid
+//! ball. Paint changes no sample but the vertices inside its ball, which lie on grid edges: for
+//! paint the ball is widened by one grid edge ([`effective_reach`]). (Radial bounds widen with edits too, but a chunk skipped before an edit held only solid
 //! or only air, and still does if none of its samples changed, so skipping never changes a mesh.)
 //!
 //! # Why the search is sound
@@ -34,7 +35,7 @@
 //! that hold a sample the brush changes, the search visits only columns near the brush, and it
 //! works on Earth-sized layouts.
 
-use crate::brush::BrushOp;
+use crate::brush::{BrushKind, BrushOp};
 use crate::region::{angle_between, ConeShell};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{face_uv_to_sphere, ChunkKey, ChunkSide, Face, Layout};
@@ -86,7 +87,7 @@ pub fn affected_chunks_at(layout: &Layout, level: u8, op: &BrushOp) -> Vec<Chunk
         return Vec::new();
     }
     let stride = 1i64 << level;
-    let reach = op.reach();
+    let reach = effective_reach(layout, level, op);
     let len = op.center.length();
     let limit = reach + 1e-9 * (len + reach) + 1e-9;
     // Directions farther than `alpha` from the centre's cannot pass within `limit` of it.
@@ -114,6 +115,28 @@ pub fn affected_chunks_at(layout: &Layout, level: u8, op: &BrushOp) -> Vec<Chunk
     }
     search.out.sort();
     search.out
+}
+
+/// The distance from a brush's centre within which a chunk's samples must lie for `op` to change
+/// its level-`level` mesh: [`BrushOp::reach`] for the brushes that shape (a mesh is a function of
+/// its samples), and for paint the reach plus the longest edge of the level's grid.
+///
+/// Paint changes no sample: it colours the mesh vertices inside its ball, and a vertex lies on a
+/// grid edge between two samples, at most half an edge from one of them (a seam patch toward a
+/// coarser neighbour has edges twice as long, so a whole edge covers both). A small paint ball
+/// can lie between samples and still hold vertices. The longest edge is the longer of the radial
+/// step `l_d s` and the chord between neighbouring lattice directions at the top of the padded
+/// shell, at most `LIPSCHITZ 2 s / N` radians apart.
+pub fn effective_reach(layout: &Layout, level: u8, op: &BrushOp) -> f64 {
+    match op.kind {
+        BrushKind::Paint { .. } => {
+            let stride = (1i64 << level) as f64;
+            let top = layout.layer_radius(layout.depth_tiles() + (1i64 << level));
+            let chord = top * LIPSCHITZ * 2.0 * stride / layout.face_tiles() as f64;
+            op.reach() + chord.max(layout.l_d() * stride)
+        }
+        _ => op.reach(),
+    }
 }
 
 /// The cap holding the directions of the face rectangle `[u0, u1] x [v0, v1]` (inside the face),
@@ -280,8 +303,9 @@ mod tests {
     use pmc_geometry::{sphere_to_face_uv, ChunkGrid, LatLon};
     use proptest::prelude::*;
 
-    /// The definition: chunks with a (valid) padded sample strictly inside the reach.
+    /// The definition: chunks with a (valid) padded sample strictly inside the (effective) reach.
     fn by_samples(layout: &Layout, level: u8, op: &BrushOp) -> Vec<ChunkKey> {
+        let reach = effective_reach(layout, level, op);
         layout
             .chunks(level)
             .into_iter()
@@ -290,7 +314,7 @@ mod tests {
                 g.dirs
                     .iter()
                     .zip(&g.valid)
-                    .any(|(d, v)| *v && g.radii.iter().any(|r| (*d * *r - op.center).length() < op.reach()))
+                    .any(|(d, v)| *v && g.radii.iter().any(|r| (*d * *r - op.center).length() < reach))
             })
             .collect()
     }
@@ -336,6 +360,79 @@ mod tests {
             }
             // And nothing else (up to rounding exactly at the edge of the reach).
             prop_assert_eq!(got, want);
+        }
+    }
+
+    /// The distance from `c` to the segment `[a, b]`.
+    fn segment_distance(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+        let ab = b - a;
+        let t = ((c - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+        (a + ab * t - c).length()
+    }
+
+    /// Chunks with a grid edge (between two of their own voxels, where mesh vertices lie) that
+    /// passes strictly inside `op`'s ball.
+    fn by_edges(layout: &Layout, level: u8, op: &BrushOp) -> Vec<ChunkKey> {
+        layout
+            .chunks(level)
+            .into_iter()
+            .filter(|key| {
+                let g = ChunkGrid::new(layout, *key);
+                let p = |a: usize, b: usize, c: usize| g.dirs[b * g.padded + a] * g.radii[c];
+                let own = 1..=g.tiles + 1;
+                own.clone().any(|c| {
+                    own.clone().any(|b| {
+                        own.clone().any(|a| {
+                            [(1, 0, 0), (0, 1, 0), (0, 0, 1)].into_iter().any(|(da, db, dc)| {
+                                own.contains(&(a + da))
+                                    && own.contains(&(b + db))
+                                    && own.contains(&(c + dc))
+                                    && segment_distance(p(a, b, c), p(a + da, b + db, c + dc), op.center) < op.reach()
+                            })
+                        })
+                    })
+                })
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(128))]
+        /// Paint changes the vertices inside its ball, which lie on grid edges: every chunk with
+        /// an edge through the ball is listed, even for a ball small enough to hold no sample.
+        #[test]
+        fn every_chunk_with_an_edge_through_a_paint_ball_is_listed(
+            level in 0u8..2,
+            face_idx in 0usize..6,
+            uv in [-1.2f64..1.2, -1.2f64..1.2],
+            depth in 0.0f64..1.0,
+            radius in 0.3f64..4.0,
+        ) {
+            let layout = Layout::new(2, 8, 60.0, 1.0, 2).unwrap();
+            let level = level.min(layout.max_level());
+            let (u, v) = (uv[0].clamp(-1.0, 1.0), uv[1].clamp(-1.0, 1.0));
+            let r = layout.d_b() + depth * (layout.radius() - layout.d_b());
+            let c = face_uv_to_sphere(Face::ALL[face_idx], u, v).normalize() * r;
+            let op = BrushOp::new(BrushKind::Paint { material: 1 }, c, radius, 1.0).unwrap();
+            let got = affected_chunks_at(&layout, level, &op);
+            for key in by_edges(&layout, level, &op) {
+                prop_assert!(got.contains(&key), "{key} missing for {op:?}");
+            }
+        }
+    }
+
+    /// A paint ball between the samples (here one on a face edge, where the failure was first
+    /// seen) still lists the chunks whose vertices it colours.
+    #[test]
+    fn a_paint_ball_between_samples_lists_its_chunks() {
+        let layout = Layout::new(2, 8, 60.0, 1.0, 2).unwrap();
+        let c = DVec3::new(51.773563991030706, 45.589669844307366, 0.0);
+        let op = BrushOp::new(BrushKind::Paint { material: 2 }, c, 2.9298586043343344, 0.2).unwrap();
+        let want = by_edges(&layout, 0, &op);
+        assert!(!want.is_empty());
+        let got = affected_chunks(&layout, &op);
+        for key in &want {
+            assert!(got.contains(key), "{key}");
         }
     }
 

@@ -32,7 +32,7 @@ mod edited;
 mod log;
 mod region;
 
-pub use affected::{affected_chunks, affected_chunks_at, affected_chunks_lod, LIPSCHITZ};
+pub use affected::{affected_chunks, affected_chunks_at, affected_chunks_lod, effective_reach, LIPSCHITZ};
 pub use brush::{falloff, BrushError, BrushKind, BrushOp, BLEND_MARGIN, MAX_BRUSH_RADIUS};
 pub use edited::{paint_at, EditedDensity};
 pub use log::{EditId, EditLog, EditSnapshot};

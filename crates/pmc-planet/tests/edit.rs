@@ -281,7 +281,9 @@ proptest! {
                 prop_assert!(listed.contains(key), "{key} changed but is not listed for {op:?}");
             }
         }
-        prop_assert!(listed.len() <= changed + 16 || listed.len() <= 2 * changed + 4, "{} listed, {changed} changed", listed.len());
+        // Paint is widened by one grid edge (up to 10 m here) and may change nothing (a material the
+        // sphere lacks), so the slack is a few columns of chunks.
+        prop_assert!(listed.len() <= changed + 24 || listed.len() <= 2 * changed + 4, "{} listed, {changed} changed", listed.len());
     }
 }
 

@@ -287,6 +287,38 @@ fn edits_change_only_the_listed_chunks_of_every_level() {
         "{changed_levels:?}"
     );
     assert!(seam_only > 0, "no brush reached a coarser chunk's seam samples only");
+
+    // Paint changes no sample but the vertices in its ball: small balls, between the samples of
+    // every level, still change only listed chunks, and some of them do change a mesh.
+    let mut painted = 0;
+    for step in 0..12 {
+        let u = -0.3 + 0.6 * f64::from(step) / 11.0;
+        let dir = pmc_geometry::face_uv_to_sphere(Face::Top, u, 0.021).normalize();
+        // On the surface (bisection on the density between the shell's bounds).
+        let (mut lo, mut hi) = (layout.d_b(), layout.radius());
+        for _ in 0..60 {
+            let m = 0.5 * (lo + hi);
+            if planet.density().density(dir * m) > 0.0 {
+                lo = m;
+            } else {
+                hi = m;
+            }
+        }
+        let op = BrushOp::new(BrushKind::Paint { material: 1 }, dir * lo, 1.2, 1.0).unwrap();
+        let edited = planet.clone().with_edits(vec![op].into());
+        let listed: BTreeSet<ChunkKey> = affected_chunks_lod(&layout, &op).into_iter().collect();
+        for level in 0..=layout.max_level() {
+            for key in layout.chunks(level) {
+                for mask in [SideMask::NONE, SideMask::ALL] {
+                    if planet.chunk_mesh_lod(key, mask) != edited.chunk_mesh_lod(key, mask) {
+                        assert!(listed.contains(&key), "{key} (mask {mask:?}) painted but is not listed");
+                        painted += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(painted > 0, "no paint brush met a vertex");
 }
 
 /// Seam patches read a coarser neighbour's samples from the base cache when it holds them: the
