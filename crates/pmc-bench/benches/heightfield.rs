@@ -88,6 +88,10 @@ impl LatticeHeights for CubeHeights {
     fn heights(&self, points: &[IVec3], m: i32, out: &mut [f64]) {
         self.0.heights_at_lattice(points, m, out)
     }
+
+    fn heights_on_grid(&self, grid: &pmc_geometry::FaceGrid, points: &[IVec3], m: i32, out: &mut [f64]) {
+        self.0.heights_on_grid(grid, points, m, out)
+    }
 }
 
 fn etopo_cube() -> CubeHeights {

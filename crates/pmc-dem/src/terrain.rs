@@ -71,6 +71,19 @@ impl DemHeights {
         self.dem
             .heights_at_lattice(points, m, self.interpolation, &self.detail, out)
     }
+
+    /// [`DemHeights::heights_at_lattice`] of the entries of a face grid, with the same bits (see
+    /// [`CubeDem::heights_on_grid`]).
+    pub fn heights_on_grid(
+        &self,
+        grid: &pmc_geometry::FaceGrid,
+        points: &[pmc_geometry::glam::IVec3],
+        m: i32,
+        out: &mut [f64],
+    ) {
+        self.dem
+            .heights_on_grid(grid, points, m, self.interpolation, &self.detail, out)
+    }
 }
 
 impl HeightField for DemHeights {

@@ -549,6 +549,39 @@ mod level_tests {
     }
 }
 
+/// A square block of face grid indices: entry `(a, b)` (`a, b` in `0..side`) is index
+/// `(i0 + a, j0 + b)` of `face`, stored at `b * side + a`. Batched samplers take one with its
+/// points ([`face_lattice`] of each entry) to use the structure: a row shares its `j`, a column
+/// its `i`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FaceGrid {
+    /// The face.
+    pub face: Face,
+    /// Face index along `u` of entry `(0, 0)` (may lie past the face's edge).
+    pub i0: i64,
+    /// Face index along `v` of entry `(0, 0)`.
+    pub j0: i64,
+    /// Entries per side.
+    pub side: usize,
+}
+
+impl FaceGrid {
+    /// Number of entries, `side^2`.
+    pub fn len(&self) -> usize {
+        self.side * self.side
+    }
+
+    /// Whether the grid has no entry.
+    pub fn is_empty(&self) -> bool {
+        self.side == 0
+    }
+
+    /// Face indices of entry `(a, b)`.
+    pub fn indices(&self, a: usize, b: usize) -> (i64, i64) {
+        (self.i0 + a as i64, self.j0 + b as i64)
+    }
+}
+
 /// The canonical lattice point of face grid index `(i, j)` at resolution `m` (grid steps per face
 /// side): `m n + (2i - m) u + (2j - m) v` in the face's frame, every component in `[-m, m]`.
 ///

@@ -2,6 +2,7 @@
 
 use crate::lattice::lattice_direction;
 use pmc_geometry::glam::IVec3;
+use pmc_geometry::FaceGrid;
 
 /// Heights of the planet's surface at canonical lattice points.
 ///
@@ -34,6 +35,15 @@ pub trait LatticeHeights: Send + Sync {
             *h = self.height(*p, m);
         }
     }
+
+    /// [`LatticeHeights::heights`] of the entries of a face grid: `points[b * side + a]` is
+    /// `face_lattice(grid.face, i, j, m)` for the entry's indices `(i, j)` wherever that point
+    /// exists (any valid point elsewhere). A source may use the grid's rows and columns; the
+    /// default ignores them. The same bits as `heights` either way.
+    fn heights_on_grid(&self, grid: &FaceGrid, points: &[IVec3], m: i32, out: &mut [f64]) {
+        debug_assert_eq!(grid.len(), points.len(), "one point per grid entry");
+        self.heights(points, m, out)
+    }
 }
 
 impl<T: LatticeHeights + ?Sized> LatticeHeights for &T {
@@ -43,6 +53,10 @@ impl<T: LatticeHeights + ?Sized> LatticeHeights for &T {
 
     fn heights(&self, points: &[IVec3], m: i32, out: &mut [f64]) {
         (**self).heights(points, m, out)
+    }
+
+    fn heights_on_grid(&self, grid: &FaceGrid, points: &[IVec3], m: i32, out: &mut [f64]) {
+        (**self).heights_on_grid(grid, points, m, out)
     }
 }
 

@@ -4,7 +4,7 @@ use crate::heights::LatticeHeights;
 use crate::lattice::{canonical_lattice, face_lattice, lattice_direction, PATCH_SEGMENTS, PATCH_SIDE};
 use crate::patch::{Corner, PatchError, PatchKey, Side, Stitch};
 use pmc_geometry::glam::{DVec3, IVec3};
-use pmc_geometry::{EdgeKey, VoxelKey};
+use pmc_geometry::{EdgeKey, FaceGrid, VoxelKey};
 use pmc_mesh::ChunkMesh;
 use std::cell::RefCell;
 use std::sync::OnceLock;
@@ -181,7 +181,13 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
         let Scratch { lattice, hs, pos } = &mut *scratch;
         fill_lattice(key, lattice);
         hs.resize(lattice.len(), 0.0);
-        heights.heights(lattice, m as i32, hs);
+        let grid = FaceGrid {
+            face: key.face,
+            i0: SEG * i64::from(key.i) - 1,
+            j0: SEG * i64::from(key.j) - 1,
+            side: GRID,
+        };
+        heights.heights_on_grid(&grid, lattice, m as i32, hs);
         pos.clear();
         pos.extend(
             lattice
@@ -215,8 +221,8 @@ thread_local! {
 }
 
 /// The lattice points of the 67 × 67 sample grid: the patch incrementally, the border by
-/// unfolding. The four grid corners are never read; they repeat the nearest patch corner so that
-/// every entry is a valid point.
+/// unfolding. The four grid corners are never read; where there is no lattice point (past a cube
+/// corner) they repeat the nearest patch corner, so that every entry is a valid point.
 fn fill_lattice(key: PatchKey, lattice: &mut Vec<IVec3>) {
     let fr = key.face.frame();
     let base = key.vertex_lattice(0, 0).expect("patch corner lies on the face");
@@ -227,8 +233,10 @@ fn fill_lattice(key: PatchKey, lattice: &mut Vec<IVec3>) {
         for a in -1..=SEG + 1 {
             let border_col = !(0..=SEG).contains(&a);
             let p = if border_row && border_col {
-                let (ca, cb) = (a.clamp(0, SEG), b.clamp(0, SEG));
-                base + du * ca as i32 + dv * cb as i32
+                key.vertex_lattice(a, b).unwrap_or_else(|| {
+                    let (ca, cb) = (a.clamp(0, SEG), b.clamp(0, SEG));
+                    base + du * ca as i32 + dv * cb as i32
+                })
             } else if border_row || border_col {
                 key.vertex_lattice(a, b)
                     .expect("border samples lie past one edge at most")

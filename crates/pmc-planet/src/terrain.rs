@@ -84,6 +84,16 @@ impl pmc_heightfield::LatticeHeights for DemLattice {
     fn heights(&self, points: &[pmc_geometry::glam::IVec3], m: i32, out: &mut [f64]) {
         self.0.heights_at_lattice(points, m, out)
     }
+
+    fn heights_on_grid(
+        &self,
+        grid: &pmc_geometry::FaceGrid,
+        points: &[pmc_geometry::glam::IVec3],
+        m: i32,
+        out: &mut [f64],
+    ) {
+        self.0.heights_on_grid(grid, points, m, out)
+    }
 }
 
 /// The terrain of the elevation model `spec` (on its own layout) and its height-field meshing

@@ -2,7 +2,7 @@
 //! lattices line up with the cube lattice, so that every octave is exactly zero at every data
 //! sample.
 
-use pmc_density::noise::{derive_seed, gradient3, gradient3_x8, Lanes8, LANES};
+use pmc_density::noise::{derive_seed, gradient3, gradient3_accumulate, gradient3_x8, Lanes8, LANES};
 use pmc_geometry::glam::DVec3;
 
 /// Default noise seed of [`DetailNoise`].
@@ -139,9 +139,56 @@ impl DetailNoise {
     }
 }
 
+impl DetailNoise {
+    /// [`DetailNoise::sum`] at every point of `points` (one octave count), into `out`, with the
+    /// same bits: one octave at a time over all the points ([`gradient3_accumulate`]), each point's
+    /// octaves still added in octave order.
+    ///
+    /// Panics when `out` and `points` differ in length (a caller's bug).
+    pub(crate) fn sum_many(&self, points: &[DVec3], octaves: u32, spacing: f64, out: &mut [f64]) {
+        assert_eq!(points.len(), out.len(), "one output per point");
+        out.fill(0.0);
+        let x: Vec<f64> = points.iter().map(|p| p.x).collect();
+        let y: Vec<f64> = points.iter().map(|p| p.y).collect();
+        let z: Vec<f64> = points.iter().map(|p| p.z).collect();
+        let mut scale = 1.0;
+        let mut amp = self.amplitude(spacing);
+        for k in 0..octaves.min(MAX_DETAIL_OCTAVES) {
+            gradient3_accumulate(&x, &y, &z, scale, derive_seed(self.seed, u64::from(k)), amp, out);
+            scale *= 2.0;
+            amp *= 0.5;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn many_points_at_once_give_the_bits_of_one_at_a_time() {
+        let d = DetailNoise::default();
+        let points: Vec<DVec3> = (0..203)
+            .map(|i| {
+                DVec3::new(
+                    12.3 + 0.37 * f64::from(i),
+                    -45.6 - 0.11 * f64::from(i),
+                    789.01 + f64::from(i % 7),
+                )
+            })
+            .collect();
+        for octaves in [0u32, 1, 4, 9, 31] {
+            let mut out = vec![f64::NAN; points.len()];
+            d.sum_many(&points, octaves, 9000.0, &mut out);
+            for (p, o) in points.iter().zip(&out) {
+                assert_eq!(
+                    o.to_bits(),
+                    d.sum(*p, octaves, 9000.0).to_bits(),
+                    "{octaves} octaves at {p}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn eight_octaves_at_once_add_up_to_the_octave_by_octave_sum() {

@@ -4,7 +4,7 @@ use super::detail::{DetailNoise, MAX_DETAIL_OCTAVES};
 use super::lattice::{home_face, indices_on, unfold};
 use super::reader::CubeDem;
 use pmc_geometry::glam::{DVec3, IVec3};
-use pmc_geometry::{face_uv_to_cube, sphere_to_face_uv, Face};
+use pmc_geometry::{face_uv_to_cube, sphere_to_face_uv, Face, FaceGrid};
 
 pub use pmc_density::terrain::Interpolation;
 
@@ -148,17 +148,20 @@ impl CubeDem {
                 let hi = c + fs * (d - c);
                 lo + ft * (hi - lo)
             }
-            Interpolation::Bicubic => {
-                let ws = catmull_rom(fs);
-                let wt = catmull_rom(ft);
-                let mut total = 0.0;
-                for (dj, wj) in wt.iter().enumerate() {
-                    let row: f64 = ws.iter().enumerate().map(|(di, wi)| wi * b[dj * 4 + di]).sum();
-                    total += wj * row;
-                }
-                total.clamp(self.header.min, self.header.max)
-            }
+            Interpolation::Bicubic => self.bicubic_block(b, &catmull_rom(fs), &catmull_rom(ft)),
         }
+    }
+
+    /// The bicubic value of a 4 x 4 block with the Catmull-Rom weights `ws` (along `s`) and `wt`
+    /// (along `t`), clamped to the data's range.
+    #[inline]
+    fn bicubic_block(&self, b: &[f64; 16], ws: &[f64; 4], wt: &[f64; 4]) -> f64 {
+        let mut total = 0.0;
+        for (dj, wj) in wt.iter().enumerate() {
+            let row: f64 = ws.iter().enumerate().map(|(di, wi)| wi * b[dj * 4 + di]).sum();
+            total += wj * row;
+        }
+        total.clamp(self.header.min, self.header.max)
     }
 
     /// The relief weights of the middle cell's four corners (in `relief`'s order of neighbours).
@@ -334,14 +337,21 @@ impl CubeDem {
         type Cell = ((Face, i32, i32), Option<([f64; 16], [f64; 4])>);
         let mut cells: Vec<Cell> = Vec::new();
         let mut last = 0usize;
-        for (lattice, h) in points.iter().zip(out.iter_mut()) {
+        let detail_on = detail.is_on();
+        // Pass 1 finds each point's cell. The points inside a whole 4 x 4 block (nearly all) are
+        // listed with their cell and fractions, and evaluated in the tight loop of pass 2, where
+        // consecutive points' arithmetic overlaps; the others are done here.
+        let mut blocked: Vec<(u32, u32, f64, f64)> = Vec::with_capacity(points.len());
+        // The points that get detail: their index, interpolated value and relief weight.
+        let mut pending: Vec<(usize, f64, f64)> = Vec::new();
+        let scale = f64::from(big_n) / (2.0 * f64::from(m));
+        for (at, (lattice, h)) in points.iter().zip(out.iter_mut()).enumerate() {
             let valid = lattice.abs().max_element() <= m && (*lattice + IVec3::splat(m)) % 2 == IVec3::ZERO;
             let face = if fine && valid { home_face(*lattice, m) } else { None };
             let Some(face) = face else {
                 *h = self.height_at_lattice(*lattice, m, interp, detail);
                 continue;
             };
-            let scale = f64::from(big_n) / (2.0 * f64::from(m));
             let fr = face.frame();
             let s = f64::from(fr.u.dot(*lattice) + m) * scale;
             let t = f64::from(fr.v.dot(*lattice) + m) * scale;
@@ -355,7 +365,7 @@ impl CubeDem {
                     Some(at) => at,
                     None => {
                         let block = self.block(face, i0, j0).map(|b| {
-                            let r = if detail.is_on() {
+                            let r = if detail_on {
                                 self.block_reliefs(&b, detail)
                             } else {
                                 [1.0; 4]
@@ -367,19 +377,154 @@ impl CubeDem {
                     }
                 };
             }
-            let (value, weight) = match &cells[last].1 {
-                Some((b, r)) => {
-                    let value = self.block_value(b, fs, ft, interp);
-                    (value, if detail.is_on() { lerp_reliefs(r, fs, ft) } else { 1.0 })
-                }
-                None => self.interpolate_samples(face, i0, j0, fs, ft, interp, detail),
-            };
-            *h = if detail.is_on() {
-                let octaves = m.trailing_zeros() - n;
-                value + weight * detail.sum(lattice.as_dvec3() * scale, octaves, self.data_spacing())
+            if cells[last].1.is_some() {
+                blocked.push((at as u32, last as u32, fs, ft));
             } else {
-                value
+                let (value, weight) = self.interpolate_samples(face, i0, j0, fs, ft, interp, detail);
+                *h = value;
+                if detail_on {
+                    pending.push((at, value, weight));
+                }
+            }
+        }
+        // Pass 2: the blocked points.
+        for &(at, cell, fs, ft) in &blocked {
+            let Some((b, r)) = &cells[cell as usize].1 else {
+                unreachable!("only points of whole blocks are listed")
             };
+            let value = self.block_value(b, fs, ft, interp);
+            out[at as usize] = value;
+            if detail_on {
+                pending.push((at as usize, value, lerp_reliefs(r, fs, ft)));
+            }
+        }
+        // Pass 3: the detail of all of them at once.
+        if !pending.is_empty() {
+            let octaves = m.trailing_zeros() - n;
+            let noise_at: Vec<DVec3> = pending
+                .iter()
+                .map(|(at, _, _)| points[*at].as_dvec3() * scale)
+                .collect();
+            let mut sums = vec![0.0; noise_at.len()];
+            detail.sum_many(&noise_at, octaves, self.data_spacing(), &mut sums);
+            for ((at, value, weight), sum) in pending.into_iter().zip(sums) {
+                out[at] = value + weight * sum;
+            }
+        }
+    }
+
+    /// [`CubeDem::heights_at_lattice`] of the entries of a face grid (`points[b * side + a]` is
+    /// the lattice point of the entry's face indices wherever one exists), with the same bits.
+    ///
+    /// The entries strictly inside the face share their column's sample cell, fraction and
+    /// bicubic weights along `u` and their row's along `v`, computed once; the others (on or past
+    /// the face's edges, where several faces meet) go through [`CubeDem::heights_at_lattice`].
+    ///
+    /// Panics when `points`, `out` and the grid differ in length (a caller's bug).
+    #[allow(clippy::too_many_arguments)]
+    pub fn heights_on_grid(
+        &self,
+        grid: &FaceGrid,
+        points: &[IVec3],
+        m: i32,
+        interp: Interpolation,
+        detail: &DetailNoise,
+        out: &mut [f64],
+    ) {
+        assert!(
+            points.len() == out.len() && points.len() == grid.len(),
+            "one point and one output per grid entry"
+        );
+        let n = self.header.n;
+        let big_n = 1i32 << n;
+        let fine = m > big_n && m <= MAX_LATTICE_RESOLUTION && m.count_ones() == 1;
+        if !fine {
+            return self.heights_at_lattice(points, m, interp, detail, out);
+        }
+        let scale = f64::from(big_n) / (2.0 * f64::from(m));
+        let rf = f64::from(big_n);
+        // A column's or a row's cell, fraction and weights: the per-point path's `cell` of
+        // `s = 2 i scale` (`fr.u . p + m = 2 i` for a point of the face), split by axis.
+        let axis = |first: i64| -> Vec<Option<(i32, f64, [f64; 4])>> {
+            (0..grid.side as i64)
+                .map(|a| {
+                    let i = first + a;
+                    (0 < i && i < i64::from(m)).then(|| {
+                        let s = (f64::from(2 * i as i32) * scale).clamp(0.0, rf);
+                        let c = (s.floor() as i32).min(big_n - 1);
+                        let f = s - f64::from(c);
+                        (c, f, catmull_rom(f))
+                    })
+                })
+                .collect()
+        };
+        let (cols, rows) = (axis(grid.i0), axis(grid.j0));
+        let detail_on = detail.is_on();
+        type Cell = ((i32, i32), Option<([f64; 16], [f64; 4])>);
+        let mut cells: Vec<Cell> = Vec::new();
+        let mut last = 0usize;
+        let mut others: Vec<usize> = Vec::new();
+        let mut pending: Vec<(usize, f64, f64)> = Vec::with_capacity(points.len());
+        for (b, row) in rows.iter().enumerate() {
+            for (a, col) in cols.iter().enumerate() {
+                let at = b * grid.side + a;
+                let (Some((j0, ft, wt)), Some((i0, fs, ws))) = (row, col) else {
+                    others.push(at);
+                    continue;
+                };
+                let key = (*i0, *j0);
+                if cells.get(last).is_none_or(|c| c.0 != key) {
+                    last = match cells.iter().position(|c| c.0 == key) {
+                        Some(at) => at,
+                        None => {
+                            let block = self.block(grid.face, *i0, *j0).map(|b| {
+                                let r = if detail_on {
+                                    self.block_reliefs(&b, detail)
+                                } else {
+                                    [1.0; 4]
+                                };
+                                (b, r)
+                            });
+                            cells.push((key, block));
+                            cells.len() - 1
+                        }
+                    };
+                }
+                let (value, weight) = match &cells[last].1 {
+                    Some((blk, r)) => {
+                        let value = match interp {
+                            Interpolation::Bicubic => self.bicubic_block(blk, ws, wt),
+                            Interpolation::Bilinear => self.block_value(blk, *fs, *ft, interp),
+                        };
+                        (value, if detail_on { lerp_reliefs(r, *fs, *ft) } else { 1.0 })
+                    }
+                    None => self.interpolate_samples(grid.face, *i0, *j0, *fs, *ft, interp, detail),
+                };
+                out[at] = value;
+                if detail_on {
+                    pending.push((at, value, weight));
+                }
+            }
+        }
+        if !pending.is_empty() {
+            let octaves = m.trailing_zeros() - n;
+            let noise_at: Vec<DVec3> = pending
+                .iter()
+                .map(|(at, _, _)| points[*at].as_dvec3() * scale)
+                .collect();
+            let mut sums = vec![0.0; noise_at.len()];
+            detail.sum_many(&noise_at, octaves, self.data_spacing(), &mut sums);
+            for ((at, value, weight), sum) in pending.into_iter().zip(sums) {
+                out[at] = value + weight * sum;
+            }
+        }
+        if !others.is_empty() {
+            let subset: Vec<IVec3> = others.iter().map(|at| points[*at]).collect();
+            let mut heights = vec![0.0; subset.len()];
+            self.heights_at_lattice(&subset, m, interp, detail, &mut heights);
+            for (at, h) in others.into_iter().zip(heights) {
+                out[at] = h;
+            }
         }
     }
 
@@ -477,6 +622,51 @@ mod tests {
                 }
             }
         }
+        // Face grids (patch-sized, with a border) inside faces, over face edges and cube corners
+        // and across tile borders, at resolutions finer and coarser than the data: the bits of
+        // one point at a time.
+        let mut grids = 0;
+        for m in [64, 512, 4096, 1 << 16, 1 << 20] {
+            let side = 67usize;
+            let starts = [
+                -1i64,
+                0,
+                1,
+                i64::from(m) / 2 - 33,
+                i64::from(m) / 3,
+                i64::from(m) - 66,
+                i64::from(m) - 65,
+            ];
+            for face in Face::ALL {
+                for (k, i0) in starts.iter().enumerate() {
+                    let j0 = starts[(k * 3 + face.index()) % starts.len()];
+                    let grid = FaceGrid {
+                        face,
+                        i0: *i0,
+                        j0,
+                        side,
+                    };
+                    let points: Vec<IVec3> = (0..grid.len())
+                        .map(|e| {
+                            let (i, j) = grid.indices(e % side, e / side);
+                            pmc_geometry::face_lattice(face, i, j, i64::from(m)).unwrap_or(IVec3::new(m, m, m))
+                        })
+                        .collect();
+                    for interp in [Interpolation::Bilinear, Interpolation::Bicubic] {
+                        for detail in [DetailNoise::default(), DetailNoise::OFF] {
+                            let mut on_grid = vec![0.0; points.len()];
+                            cube.heights_on_grid(&grid, &points, m, interp, &detail, &mut on_grid);
+                            for (p, h) in points.iter().zip(&on_grid) {
+                                let one = cube.height_at_lattice(*p, m, interp, &detail);
+                                assert_eq!(h.to_bits(), one.to_bits(), "{grid:?} {p} at {m}: {h} vs {one}");
+                            }
+                        }
+                    }
+                    grids += 1;
+                }
+            }
+        }
+        assert_eq!(grids, 5 * 6 * 7);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

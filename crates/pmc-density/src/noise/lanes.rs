@@ -62,6 +62,36 @@ pub fn gradient3_x8(q: &Lanes8) -> [f64; LANES] {
     scalar(q)
 }
 
+/// `out[i] += amp * gradient3((x[i], y[i], z[i]) * scale, seed)` for every `i`, bit for bit:
+/// one octave of one field at many points (a height-field patch's thousands of vertices), added
+/// to a running fractal sum.
+///
+/// On the vector path the points go through the lanes eight at a time inside one loop: no
+/// per-call feature test, inputs read straight from the slices, the scaling and the sum done in
+/// registers (a multiply, then an add: the scalar order), two groups of eight at a time so that
+/// their chains overlap. Points on an axis-aligned plane of the noise lattice (a cube face's
+/// points, whose third coordinate is a lattice integer) need only four of a cell's eight
+/// corners: where two whole groups have a zero fraction along one axis, the four corners on that
+/// plane give the same value (a fade of 0 leaves the lerps' first terms) up to the sign of a
+/// zero, which the dropped corners decide: it is lost when added to a nonzero sum, and a group
+/// where a zero value meets a zero sum is redone with all eight corners. The last `len % 8`
+/// points take the scalar kernel.
+///
+/// Panics when the four slices differ in length (a caller's bug).
+pub fn gradient3_accumulate(x: &[f64], y: &[f64], z: &[f64], scale: f64, seed: u64, amp: f64, out: &mut [f64]) {
+    assert!(
+        x.len() == out.len() && y.len() == out.len() && z.len() == out.len(),
+        "one output per point"
+    );
+    #[cfg(target_arch = "x86_64")]
+    let done = x86::gradient3_accumulate(x, y, z, scale, seed, amp, out);
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = 0;
+    for i in done..out.len() {
+        out[i] += amp * gradient3(DVec3::new(x[i], y[i], z[i]) * scale, seed);
+    }
+}
+
 /// The eight evaluations by the scalar kernel.
 #[inline]
 pub(crate) fn scalar(q: &Lanes8) -> [f64; LANES] {
@@ -96,6 +126,39 @@ pub(crate) mod x86 {
         // exactly eight lanes).
         unsafe { kernel(q, &mut out) };
         Some(out)
+    }
+
+    /// [`super::gradient3_accumulate`] for the leading multiple of eight points; returns how
+    /// many were done (0 on a processor without AVX-512 F and DQ).
+    #[inline]
+    pub(crate) fn gradient3_accumulate(
+        x: &[f64],
+        y: &[f64],
+        z: &[f64],
+        scale: f64,
+        seed: u64,
+        amp: f64,
+        out: &mut [f64],
+    ) -> usize {
+        if !available() {
+            return 0;
+        }
+        let n = out.len().min(x.len()).min(y.len()).min(z.len()) / LANES * LANES;
+        // SAFETY: the processor has AVX-512 F and DQ (checked above); `accumulate_kernel` reads
+        // and writes the first `n` entries only, and every slice holds at least `n`.
+        unsafe {
+            accumulate_kernel(
+                x.as_ptr(),
+                y.as_ptr(),
+                z.as_ptr(),
+                scale,
+                seed,
+                amp,
+                out.as_mut_ptr(),
+                n,
+            )
+        };
+        n
     }
 
     /// `(cell, fraction)` of each lane, as the scalar `split`: the `1.5 * 2^52` rounding, one
@@ -172,10 +235,181 @@ pub(crate) mod x86 {
 
     #[target_feature(enable = "avx512f,avx512dq")]
     unsafe fn kernel(q: &Lanes8, out: &mut [f64; LANES]) {
-        let (ix, fx) = split(_mm512_loadu_pd(q.x.as_ptr()));
-        let (iy, fy) = split(_mm512_loadu_pd(q.y.as_ptr()));
-        let (iz, fz) = split(_mm512_loadu_pd(q.z.as_ptr()));
-        let seed = _mm512_loadu_si512(q.seed.as_ptr().cast());
+        let r = eval(
+            _mm512_loadu_pd(q.x.as_ptr()),
+            _mm512_loadu_pd(q.y.as_ptr()),
+            _mm512_loadu_pd(q.z.as_ptr()),
+            _mm512_loadu_si512(q.seed.as_ptr().cast()),
+        );
+        _mm512_storeu_pd(out.as_mut_ptr(), r);
+    }
+
+    /// Points `0..n` (a multiple of eight) of the slices, eight at a time, with one seed.
+    #[target_feature(enable = "avx512f,avx512dq")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn accumulate_kernel(
+        x: *const f64,
+        y: *const f64,
+        z: *const f64,
+        scale: f64,
+        seed: u64,
+        amp: f64,
+        out: *mut f64,
+        n: usize,
+    ) {
+        let seed = _mm512_set1_epi64(seed as i64);
+        let (scale, amp) = (_mm512_set1_pd(scale), _mm512_set1_pd(amp));
+        macro_rules! load {
+            ($i:expr) => {
+                [
+                    _mm512_mul_pd(_mm512_loadu_pd(x.add($i)), scale),
+                    _mm512_mul_pd(_mm512_loadu_pd(y.add($i)), scale),
+                    _mm512_mul_pd(_mm512_loadu_pd(z.add($i)), scale),
+                ]
+            };
+        }
+        macro_rules! add {
+            ($i:expr, $r:expr) => {
+                let sum = _mm512_add_pd(_mm512_loadu_pd(out.add($i)), _mm512_mul_pd(amp, $r));
+                _mm512_storeu_pd(out.add($i), sum);
+            };
+        }
+        let mut i = 0;
+        // Two groups at a time: their independent chains overlap in the processor.
+        while i + 2 * LANES <= n {
+            let (p, q) = (load!(i), load!(i + LANES));
+            match eval_planar_x2([p, q], seed) {
+                Some([(r, zr), (s, zs)]) => {
+                    // A zero's sign is lost in a nonzero sum; where the sum so far is zero too,
+                    // the full kernel decides it.
+                    let zero = _mm512_setzero_pd();
+                    let (o, t) = (_mm512_loadu_pd(out.add(i)), _mm512_loadu_pd(out.add(i + LANES)));
+                    let r = if zr & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(o, zero) != 0 {
+                        eval(p[0], p[1], p[2], seed)
+                    } else {
+                        r
+                    };
+                    let s = if zs & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(t, zero) != 0 {
+                        eval(q[0], q[1], q[2], seed)
+                    } else {
+                        s
+                    };
+                    add!(i, r);
+                    add!(i + LANES, s);
+                }
+                None => {
+                    add!(i, eval(p[0], p[1], p[2], seed));
+                    add!(i + LANES, eval(q[0], q[1], q[2], seed));
+                }
+            }
+            i += 2 * LANES;
+        }
+        if i < n {
+            let p = load!(i);
+            add!(i, eval(p[0], p[1], p[2], seed));
+        }
+    }
+
+    /// Two groups of eight evaluations when every lane of both has a zero fraction along the same
+    /// axis, from the four corners on that lattice plane, each with the mask of its lanes whose
+    /// value is zero (the sign of those zeros is the dropped corners' to decide); `None` when
+    /// the groups do not lie on one plane.
+    ///
+    /// The full kernel's value there is the same number: with a zero fraction the fade is `+0`,
+    /// so each lerp across that axis is `a + 0 (b - a)`, which is `a` unless `a` is zero, and the
+    /// corner dots lose a `g 0` term, which changes a sum only when it is zero. IEEE additions
+    /// and multiplications turn a difference in the sign of a zero only into another zero, so
+    /// a nonzero result has the same bits, and a zero one may differ in its sign only.
+    #[inline(always)]
+    unsafe fn eval_planar_x2(p: [[__m512d; 3]; 2], seed: __m512i) -> Option<[(__m512d, __mmask8); 2]> {
+        let zero = _mm512_setzero_pd();
+        let (c0, f0) = (split(p[0][0]), split(p[1][0]));
+        let (c1, f1) = (split(p[0][1]), split(p[1][1]));
+        let (c2, f2) = (split(p[0][2]), split(p[1][2]));
+        let flat = |a: __m512d, b: __m512d| {
+            (_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, zero) & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(b, zero)) == 0xFF
+        };
+        // The flat axis's cells, then the two free axes in the kernel's lerp order.
+        let (r0, r1) = if flat(c2.1, f2.1) {
+            (
+                plane::<LATTICE_Z, LATTICE_X, LATTICE_Y>(c2.0, c0, c1, seed, &GX, &GY),
+                plane::<LATTICE_Z, LATTICE_X, LATTICE_Y>(f2.0, f0, f1, seed, &GX, &GY),
+            )
+        } else if flat(c1.1, f1.1) {
+            (
+                plane::<LATTICE_Y, LATTICE_X, LATTICE_Z>(c1.0, c0, c2, seed, &GX, &GZ),
+                plane::<LATTICE_Y, LATTICE_X, LATTICE_Z>(f1.0, f0, f2, seed, &GX, &GZ),
+            )
+        } else if flat(c0.1, f0.1) {
+            (
+                plane::<LATTICE_X, LATTICE_Y, LATTICE_Z>(c0.0, c1, c2, seed, &GY, &GZ),
+                plane::<LATTICE_X, LATTICE_Y, LATTICE_Z>(f0.0, f1, f2, seed, &GY, &GZ),
+            )
+        } else {
+            return None;
+        };
+        let scale = _mm512_set1_pd(SCALE);
+        Some([
+            (_mm512_mul_pd(r0, scale), _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(r0, zero)),
+            (_mm512_mul_pd(r1, scale), _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(r1, zero)),
+        ])
+    }
+
+    /// One group's unscaled value on the lattice plane of cells `across` (key step `K`), with
+    /// `(cell, fraction)` along the free axes `a` and `b` (key steps `A` and `B`, gradient
+    /// components `ga` and `gb`).
+    #[inline(always)]
+    unsafe fn plane<const K: u64, const A: u64, const B: u64>(
+        across: __m512i,
+        a: (__m512i, __m512d),
+        b: (__m512i, __m512d),
+        seed: __m512i,
+        ga: &[f64; 16],
+        gb: &[f64; 16],
+    ) -> __m512d {
+        let a0 = _mm512_mullo_epi64(a.0, _mm512_set1_epi64(A as i64));
+        let b0 = _mm512_mullo_epi64(b.0, _mm512_set1_epi64(B as i64));
+        let a1 = _mm512_add_epi64(a0, _mm512_set1_epi64(A as i64));
+        let b1 = _mm512_add_epi64(b0, _mm512_set1_epi64(B as i64));
+        // The seed goes with the y key in the kernel; xor is associative, so it can go anywhere.
+        let k = _mm512_xor_si512(_mm512_mullo_epi64(across, _mm512_set1_epi64(K as i64)), seed);
+        let (ta, tb) = (Table::new(ga), Table::new(gb));
+        let (fa, fb) = (a.1, b.1);
+        let one = _mm512_set1_pd(1.0);
+        let (da, db) = (_mm512_sub_pd(fa, one), _mm512_sub_pd(fb, one));
+        let n00 = plane_dot(plane_gradient(a0, b0, k, &ta, &tb), fa, fb);
+        let n10 = plane_dot(plane_gradient(a1, b0, k, &ta, &tb), da, fb);
+        let n01 = plane_dot(plane_gradient(a0, b1, k, &ta, &tb), fa, db);
+        let n11 = plane_dot(plane_gradient(a1, b1, k, &ta, &tb), da, db);
+        let (u, v) = (fade(fa), fade(fb));
+        lerp(v, lerp(u, n00, n10), lerp(u, n01, n11))
+    }
+
+    /// The gradient components along a plane's two free axes at the corner with keys `p` and
+    /// `q` along them and `k` (seeded) across: [`corner`]'s hash and table lookups.
+    #[inline(always)]
+    unsafe fn plane_gradient(p: __m512i, q: __m512i, k: __m512i, ta: &Table, tb: &Table) -> (__m512d, __m512d) {
+        let key = _mm512_xor_si512(_mm512_xor_si512(p, q), k);
+        let h = _mm512_mullo_epi64(
+            _mm512_xor_si512(key, _mm512_srli_epi64::<32>(key)),
+            _mm512_set1_epi64(FINAL_MUL as i64),
+        );
+        let idx = _mm512_srli_epi64::<60>(h);
+        (ta.get(idx), tb.get(idx))
+    }
+
+    /// A corner's value on a plane: `ga da + gb db`.
+    #[inline(always)]
+    unsafe fn plane_dot(g: (__m512d, __m512d), da: __m512d, db: __m512d) -> __m512d {
+        _mm512_add_pd(_mm512_mul_pd(g.0, da), _mm512_mul_pd(g.1, db))
+    }
+
+    /// The eight evaluations of the points `(x, y, z)` with seeds `seed`, lane by lane.
+    #[inline(always)]
+    unsafe fn eval(x: __m512d, y: __m512d, z: __m512d, seed: __m512i) -> __m512d {
+        let (ix, fx) = split(x);
+        let (iy, fy) = split(y);
+        let (iz, fz) = split(z);
         let x0 = _mm512_mullo_epi64(ix, _mm512_set1_epi64(LATTICE_X as i64));
         let y0 = _mm512_mullo_epi64(iy, _mm512_set1_epi64(LATTICE_Y as i64));
         let z0 = _mm512_mullo_epi64(iz, _mm512_set1_epi64(LATTICE_Z as i64));
@@ -198,8 +432,7 @@ pub(crate) mod x86 {
         let (u, v, w) = (fade(fx), fade(fy), fade(fz));
         let a = lerp(v, lerp(u, n000, n100), lerp(u, n010, n110));
         let b = lerp(v, lerp(u, n001, n101), lerp(u, n011, n111));
-        let r = _mm512_mul_pd(lerp(w, a, b), _mm512_set1_pd(SCALE));
-        _mm512_storeu_pd(out.as_mut_ptr(), r);
+        _mm512_mul_pd(lerp(w, a, b), _mm512_set1_pd(SCALE))
     }
 }
 
@@ -226,6 +459,77 @@ mod tests {
             out.push((p, mix64(i ^ 0xABCD)));
         }
         out
+    }
+
+    /// The accumulated octave of many points, by the scalar kernel.
+    fn accumulate_scalar(pts: &[DVec3], scale: f64, seed: u64, amp: f64, out: &mut [f64]) {
+        for (p, o) in pts.iter().zip(out) {
+            *o += amp * gradient3(*p * scale, seed);
+        }
+    }
+
+    fn check_accumulate(pts: &[DVec3], scale: f64, seed: u64, amp: f64) {
+        let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+            pts.iter().map(|p| p.x).collect(),
+            pts.iter().map(|p| p.y).collect(),
+            pts.iter().map(|p| p.z).collect(),
+        );
+        let start: Vec<f64> = (0..pts.len()).map(|i| [0.0, -0.0, 1.5, -2.25][i % 4]).collect();
+        let (mut got, mut want) = (start.clone(), start);
+        gradient3_accumulate(&x, &y, &z, scale, seed, amp, &mut got);
+        accumulate_scalar(pts, scale, seed, amp, &mut want);
+        for i in 0..pts.len() {
+            assert_eq!(
+                got[i].to_bits(),
+                want[i].to_bits(),
+                "{:?} x {scale}, seed {seed}",
+                pts[i]
+            );
+        }
+    }
+
+    #[test]
+    fn accumulated_slices_equal_scalar_calls_bit_for_bit() {
+        let pts: Vec<DVec3> = hard_points(20_003).into_iter().map(|p| p.0).collect();
+        for (len, seed) in [(0, 1u64), (5, 2), (8, 3), (20_003, 0xDEAD_BEEF)] {
+            check_accumulate(&pts[..len], 1.0, seed, 0.75);
+            check_accumulate(&pts[..len], 0.125, seed, -3.0);
+        }
+    }
+
+    /// Points on lattice planes (the fast path) and on lattice lines and points (where values
+    /// are zero and the sign of a zero is decided by all eight corners), on each axis, with
+    /// negative zeros and huge coordinates: the bits of the scalar kernel.
+    #[test]
+    fn points_on_lattice_planes_equal_scalar_calls_bit_for_bit() {
+        let mut pts = Vec::new();
+        for axis in 0..3 {
+            for plane in [-7.0, -0.0, 0.0, 3.0, 1e6, -4.5e6] {
+                for i in 0..64 {
+                    for j in 0..24 {
+                        // Free coordinates on a grid of quarter and eighth steps, and some
+                        // random ones.
+                        let (a, b) = if j < 16 {
+                            (f64::from(i) * 0.125 - 3.0, f64::from(j) * 0.25 - 2.0)
+                        } else {
+                            let r = |k: u64| unit_f64(mix64(k ^ (i as u64) << 8 ^ (j as u64) << 20)) * 40.0 - 20.0;
+                            (r(1), r(2))
+                        };
+                        let p = match axis {
+                            0 => DVec3::new(plane, a, b),
+                            1 => DVec3::new(a, plane, b),
+                            _ => DVec3::new(a, b, plane),
+                        };
+                        pts.push(p);
+                    }
+                }
+            }
+        }
+        for seed in [0u64, 7, u64::MAX] {
+            check_accumulate(&pts, 1.0, seed, 0.5);
+            check_accumulate(&pts, 4.0, seed, 1.0);
+            check_accumulate(&pts, 0.5, seed, 1.0);
+        }
     }
 
     #[test]
