@@ -28,10 +28,20 @@ pub fn cube_to_sphere(c: DVec3) -> DVec3 {
     let y2 = c.y * c.y;
     let z2 = c.z * c.z;
     DVec3::new(
-        c.x * (1.0 - y2 * 0.5 - z2 * 0.5 + y2 * z2 / 3.0).sqrt(),
-        c.y * (1.0 - z2 * 0.5 - x2 * 0.5 + z2 * x2 / 3.0).sqrt(),
-        c.z * (1.0 - x2 * 0.5 - y2 * 0.5 + x2 * y2 / 3.0).sqrt(),
+        c.x * cube_sphere_factor(y2, z2),
+        c.y * cube_sphere_factor(z2, x2),
+        c.z * cube_sphere_factor(x2, y2),
     )
+}
+
+/// The factor of one component in [`cube_to_sphere`]: `sqrt(1 - a2/2 - b2/2 + a2 b2 / 3)` for the
+/// squares `a2`, `b2` of the two other components, in the next-then-previous axis order
+/// (`x' = x f(y^2, z^2)`, `y' = y f(z^2, x^2)`, `z' = z f(x^2, y^2)`). Callers mapping a grid of
+/// points on one face compute the factors that depend on one grid axis once per row or column,
+/// with the same bits as `cube_to_sphere`.
+#[inline]
+pub fn cube_sphere_factor(a2: f64, b2: f64) -> f64 {
+    (1.0 - a2 * 0.5 - b2 * 0.5 + a2 * b2 / 3.0).sqrt()
 }
 
 /// Solves one face coordinate of the inverse map. `a` is the squared sphere coordinate along that

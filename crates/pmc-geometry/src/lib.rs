@@ -31,7 +31,9 @@ mod latlon;
 mod layout;
 
 pub use chunk_grid::ChunkGrid;
-pub use cube_sphere::{cube_to_sphere, face_uv_to_cube, face_uv_to_sphere, sphere_to_cube, sphere_to_face_uv};
+pub use cube_sphere::{
+    cube_sphere_factor, cube_to_sphere, face_uv_to_cube, face_uv_to_sphere, sphere_to_cube, sphere_to_face_uv,
+};
 pub use face::{Face, FaceAxis, FaceFrame};
 pub use face_conversion::{convert_axis, AxisMap, FaceTransition};
 pub use glam;

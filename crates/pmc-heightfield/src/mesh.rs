@@ -4,7 +4,7 @@ use crate::heights::LatticeHeights;
 use crate::lattice::{canonical_lattice, face_lattice, lattice_direction, PATCH_SEGMENTS, PATCH_SIDE};
 use crate::patch::{Corner, PatchError, PatchKey, Side, Stitch};
 use pmc_geometry::glam::{DVec3, IVec3};
-use pmc_geometry::{EdgeKey, FaceGrid, VoxelKey};
+use pmc_geometry::{cube_sphere_factor, EdgeKey, FaceGrid, VoxelKey};
 use pmc_mesh::ChunkMesh;
 use std::cell::RefCell;
 use std::sync::OnceLock;
@@ -188,13 +188,7 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
             side: GRID,
         };
         heights.heights_on_grid(&grid, lattice, m as i32, hs);
-        pos.clear();
-        pos.extend(
-            lattice
-                .iter()
-                .zip(hs.iter())
-                .map(|(p, h)| lattice_direction(*p, m) * (radius + h)),
-        );
+        fill_positions(key, lattice, hs, radius, m, pos);
         let samples = Samples {
             heights,
             key,
@@ -206,6 +200,55 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
         write_mesh(&samples, hs, stitch, out);
     });
     Ok(())
+}
+
+/// The positions of the sample grid, `lattice_direction(p, m) * (radius + h)` with the same bits:
+/// on the patch's face, the cube-to-sphere factor of the component along the face's `u` axis
+/// depends on the row alone and the one along `v` on the column alone, so they are computed once
+/// per row and column (the points past the face's edges take the whole map).
+fn fill_positions(key: PatchKey, lattice: &[IVec3], hs: &[f64], radius: f64, m: i64, pos: &mut Vec<DVec3>) {
+    let fr = key.face.frame();
+    let axis = |v: IVec3| {
+        if v.x != 0 {
+            0
+        } else if v.y != 0 {
+            1
+        } else {
+            2
+        }
+    };
+    let (ku, kv) = (axis(fr.u), axis(fr.v));
+    let inv = 1.0 / m as f64;
+    let (fi, fj) = (SEG * i64::from(key.i) - 1, SEG * i64::from(key.j) - 1);
+    let on_face = |x: i64| (0..=m).contains(&x);
+    // Component `k`'s factor from the squares `sq` (see `cube_sphere_factor`).
+    let factor = |k: usize, sq: [f64; 3]| cube_sphere_factor(sq[(k + 1) % 3], sq[(k + 2) % 3]);
+    let mut columns: [Option<f64>; GRID] = [None; GRID];
+    pos.clear();
+    for (b, (row_points, row_heights)) in lattice.chunks_exact(GRID).zip(hs.chunks_exact(GRID)).enumerate() {
+        let mut row: Option<f64> = None;
+        for (a, (p, h)) in row_points.iter().zip(row_heights).enumerate() {
+            let (i, j) = (fi + a as i64, fj + b as i64);
+            let dir = if on_face(i) && on_face(j) {
+                let c = p.as_dvec3() * inv;
+                let sq = [c.x * c.x, c.y * c.y, c.z * c.z];
+                let mut f = [0.0; 3];
+                for (k, fk) in f.iter_mut().enumerate() {
+                    *fk = if k == ku {
+                        *row.get_or_insert_with(|| factor(k, sq))
+                    } else if k == kv {
+                        *columns[a].get_or_insert_with(|| factor(k, sq))
+                    } else {
+                        factor(k, sq)
+                    };
+                }
+                DVec3::new(c.x * f[0], c.y * f[1], c.z * f[2])
+            } else {
+                lattice_direction(*p, m)
+            };
+            pos.push(dir * (radius + h));
+        }
+    }
 }
 
 /// Per-thread sample buffers, so that generating a patch allocates nothing once warm.
@@ -335,6 +378,35 @@ pub fn vertex_canonical_lattice(key: PatchKey, a: u32, b: u32) -> Option<IVec3> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use pmc_geometry::Face;
+
+    /// The row and column factors give the bits of the whole map, on every face, at face edges
+    /// and cube corners, at several levels.
+    #[test]
+    fn grid_positions_are_the_bits_of_the_map() {
+        let heights: Vec<f64> = (0..GRID * GRID).map(|k| (k % 97) as f64 * 13.7 - 300.0).collect();
+        let mut lattice = Vec::new();
+        let mut pos = Vec::new();
+        for face in Face::ALL {
+            for level in [0u8, 1, 3, 9] {
+                let n = 1u32 << level;
+                for (i, j) in [(0, 0), (n - 1, 0), (n / 2, n / 3), (n - 1, n - 1), (0, n - 1)] {
+                    let key = PatchKey::new(face, level, i, j).unwrap();
+                    let m = key.resolution();
+                    fill_lattice(key, &mut lattice);
+                    fill_positions(key, &lattice, &heights, 6.371e6, m, &mut pos);
+                    for ((p, h), got) in lattice.iter().zip(&heights).zip(&pos) {
+                        let want = lattice_direction(*p, m) * (6.371e6 + h);
+                        assert_eq!(
+                            got.to_array().map(f64::to_bits),
+                            want.to_array().map(f64::to_bits),
+                            "{key} {p}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn index_buffers_cover_the_patch_once() {

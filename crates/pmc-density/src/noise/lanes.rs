@@ -274,11 +274,12 @@ pub(crate) mod x86 {
                 _mm512_storeu_pd(out.add($i), sum);
             };
         }
+        let mut cache = PlaneCache::new();
         let mut i = 0;
         // Two groups at a time: their independent chains overlap in the processor.
         while i + 2 * LANES <= n {
             let (p, q) = (load!(i), load!(i + LANES));
-            match eval_planar_x2([p, q], seed) {
+            match eval_planar_x2([p, q], seed, &mut cache) {
                 Some([(r, zr), (s, zs)]) => {
                     // A zero's sign is lost in a nonzero sum; where the sum so far is zero too,
                     // the full kernel decides it.
@@ -321,66 +322,122 @@ pub(crate) mod x86 {
     /// and multiplications turn a difference in the sign of a zero only into another zero, so
     /// a nonzero result has the same bits, and a zero one may differ in its sign only.
     #[inline(always)]
-    unsafe fn eval_planar_x2(p: [[__m512d; 3]; 2], seed: __m512i) -> Option<[(__m512d, __mmask8); 2]> {
+    unsafe fn eval_planar_x2(
+        p: [[__m512d; 3]; 2],
+        seed: __m512i,
+        cache: &mut PlaneCache,
+    ) -> Option<[(__m512d, __mmask8); 2]> {
         let zero = _mm512_setzero_pd();
-        let (c0, f0) = (split(p[0][0]), split(p[1][0]));
-        let (c1, f1) = (split(p[0][1]), split(p[1][1]));
-        let (c2, f2) = (split(p[0][2]), split(p[1][2]));
-        let flat = |a: __m512d, b: __m512d| {
-            (_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, zero) & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(b, zero)) == 0xFF
+        let groups = [
+            [split(p[0][0]), split(p[0][1]), split(p[0][2])],
+            [split(p[1][0]), split(p[1][1]), split(p[1][2])],
+        ];
+        let flat = |c: usize| {
+            (_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(groups[0][c].1, zero)
+                & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(groups[1][c].1, zero))
+                == 0xFF
         };
-        // The flat axis's cells, then the two free axes in the kernel's lerp order.
-        let (r0, r1) = if flat(c2.1, f2.1) {
-            (
-                plane::<LATTICE_Z, LATTICE_X, LATTICE_Y>(c2.0, c0, c1, seed, &GX, &GY),
-                plane::<LATTICE_Z, LATTICE_X, LATTICE_Y>(f2.0, f0, f1, seed, &GX, &GY),
-            )
-        } else if flat(c1.1, f1.1) {
-            (
-                plane::<LATTICE_Y, LATTICE_X, LATTICE_Z>(c1.0, c0, c2, seed, &GX, &GZ),
-                plane::<LATTICE_Y, LATTICE_X, LATTICE_Z>(f1.0, f0, f2, seed, &GX, &GZ),
-            )
-        } else if flat(c0.1, f0.1) {
-            (
-                plane::<LATTICE_X, LATTICE_Y, LATTICE_Z>(c0.0, c1, c2, seed, &GY, &GZ),
-                plane::<LATTICE_X, LATTICE_Y, LATTICE_Z>(f0.0, f1, f2, seed, &GY, &GZ),
-            )
+        let axis = if flat(2) {
+            2
+        } else if flat(1) {
+            1
+        } else if flat(0) {
+            0
         } else {
             return None;
         };
+        let mut r = [zero; 2];
+        for (g, [x, y, z]) in groups.iter().enumerate() {
+            let hit = cache.axis == axis
+                && (_mm512_cmpeq_epi64_mask(x.0, cache.cells[0])
+                    & _mm512_cmpeq_epi64_mask(y.0, cache.cells[1])
+                    & _mm512_cmpeq_epi64_mask(z.0, cache.cells[2]))
+                    == 0xFF;
+            if !hit {
+                // The flat axis's cells, then the two free axes in the kernel's lerp order.
+                cache.grads = match axis {
+                    2 => plane_gradients::<LATTICE_Z, LATTICE_X, LATTICE_Y>(z.0, x.0, y.0, seed, &GX, &GY),
+                    1 => plane_gradients::<LATTICE_Y, LATTICE_X, LATTICE_Z>(y.0, x.0, z.0, seed, &GX, &GZ),
+                    _ => plane_gradients::<LATTICE_X, LATTICE_Y, LATTICE_Z>(x.0, y.0, z.0, seed, &GY, &GZ),
+                };
+                cache.cells = [x.0, y.0, z.0];
+                cache.axis = axis;
+            }
+            let (fa, fb) = match axis {
+                2 => (x.1, y.1),
+                1 => (x.1, z.1),
+                _ => (y.1, z.1),
+            };
+            r[g] = plane_value(&cache.grads, fa, fb);
+        }
         let scale = _mm512_set1_pd(SCALE);
         Some([
-            (_mm512_mul_pd(r0, scale), _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(r0, zero)),
-            (_mm512_mul_pd(r1, scale), _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(r1, zero)),
+            (_mm512_mul_pd(r[0], scale), _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(r[0], zero)),
+            (_mm512_mul_pd(r[1], scale), _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(r[1], zero)),
         ])
     }
 
-    /// One group's unscaled value on the lattice plane of cells `across` (key step `K`), with
-    /// `(cell, fraction)` along the free axes `a` and `b` (key steps `A` and `B`, gradient
-    /// components `ga` and `gb`).
+    /// The corner gradients of the last group evaluated on a lattice plane: consecutive groups
+    /// of a row mostly share their cells in the coarser octaves, and so their corners' hashes.
+    pub(super) struct PlaneCache {
+        /// The flat axis (3: nothing cached yet).
+        axis: u8,
+        /// The lanes' cells along x, y and z.
+        cells: [__m512i; 3],
+        /// The gradient components along the two free axes at the four corners, in the order
+        /// `(0, 0), (1, 0), (0, 1), (1, 1)`.
+        grads: [(__m512d, __m512d); 4],
+    }
+
+    impl PlaneCache {
+        #[inline(always)]
+        unsafe fn new() -> PlaneCache {
+            let (zi, zd) = (_mm512_setzero_si512(), _mm512_setzero_pd());
+            PlaneCache {
+                axis: 3,
+                cells: [zi; 3],
+                grads: [(zd, zd); 4],
+            }
+        }
+    }
+
+    /// The four corner gradients (components along the free axes) of a group's cells on the
+    /// lattice plane of cells `across` (key step `K`), with cells `a` and `b` along the free
+    /// axes (key steps `A` and `B`, gradient components `ga` and `gb`).
     #[inline(always)]
-    unsafe fn plane<const K: u64, const A: u64, const B: u64>(
+    unsafe fn plane_gradients<const K: u64, const A: u64, const B: u64>(
         across: __m512i,
-        a: (__m512i, __m512d),
-        b: (__m512i, __m512d),
+        a: __m512i,
+        b: __m512i,
         seed: __m512i,
         ga: &[f64; 16],
         gb: &[f64; 16],
-    ) -> __m512d {
-        let a0 = _mm512_mullo_epi64(a.0, _mm512_set1_epi64(A as i64));
-        let b0 = _mm512_mullo_epi64(b.0, _mm512_set1_epi64(B as i64));
+    ) -> [(__m512d, __m512d); 4] {
+        let a0 = _mm512_mullo_epi64(a, _mm512_set1_epi64(A as i64));
+        let b0 = _mm512_mullo_epi64(b, _mm512_set1_epi64(B as i64));
         let a1 = _mm512_add_epi64(a0, _mm512_set1_epi64(A as i64));
         let b1 = _mm512_add_epi64(b0, _mm512_set1_epi64(B as i64));
         // The seed goes with the y key in the kernel; xor is associative, so it can go anywhere.
         let k = _mm512_xor_si512(_mm512_mullo_epi64(across, _mm512_set1_epi64(K as i64)), seed);
         let (ta, tb) = (Table::new(ga), Table::new(gb));
-        let (fa, fb) = (a.1, b.1);
+        [
+            plane_gradient(a0, b0, k, &ta, &tb),
+            plane_gradient(a1, b0, k, &ta, &tb),
+            plane_gradient(a0, b1, k, &ta, &tb),
+            plane_gradient(a1, b1, k, &ta, &tb),
+        ]
+    }
+
+    /// A group's unscaled value on a lattice plane from its corner gradients and its fractions
+    /// along the free axes.
+    #[inline(always)]
+    unsafe fn plane_value(g: &[(__m512d, __m512d); 4], fa: __m512d, fb: __m512d) -> __m512d {
         let one = _mm512_set1_pd(1.0);
         let (da, db) = (_mm512_sub_pd(fa, one), _mm512_sub_pd(fb, one));
-        let n00 = plane_dot(plane_gradient(a0, b0, k, &ta, &tb), fa, fb);
-        let n10 = plane_dot(plane_gradient(a1, b0, k, &ta, &tb), da, fb);
-        let n01 = plane_dot(plane_gradient(a0, b1, k, &ta, &tb), fa, db);
-        let n11 = plane_dot(plane_gradient(a1, b1, k, &ta, &tb), da, db);
+        let n00 = plane_dot(g[0], fa, fb);
+        let n10 = plane_dot(g[1], da, fb);
+        let n01 = plane_dot(g[2], fa, db);
+        let n11 = plane_dot(g[3], da, db);
         let (u, v) = (fade(fa), fade(fb));
         lerp(v, lerp(u, n00, n10), lerp(u, n01, n11))
     }
