@@ -9,8 +9,9 @@
 //!
 //! - `etopo-cube+detail`: the real thing, `pmc_dem::DemHeights::height_at_lattice` on the ETOPO60
 //!   fixture imported at data level 10 (1025 x 1025 samples a face, as ETOPO5's default import):
-//!   bicubic data through the tiled reader, relief weights, and the 4 detail octaves a level-14
-//!   vertex gets (the finer ones are exactly zero there).
+//!   bicubic data through the tiled reader, relief weights, and the 10 detail octaves a level-14
+//!   vertex gets (lattice 2^20 over data on 2^10; the finer ones are exactly zero there), through
+//!   `heights_on_grid` as the height-field planet calls it.
 //!
 //! Seed 003 reports about 22 ms per patch for its sampling.
 use criterion::{criterion_group, criterion_main, Criterion};
