@@ -969,7 +969,7 @@ async function main() {
     await server.stop();
   });
 
-  await step('10. the Earth at true scale: orbit and 2 m over an ocean floor, orbit, 10 km, 100 m and 2 m over mountains, a zoom down and back up, no crack or hole, no jitter at 6.4e6 m', async () => {
+  await step('10. the Earth at true scale: orbit and 2 m over an ocean floor, orbit, 10 km, 100 m and 2 m over mountains, no crack or hole, no jitter at 6.4e6 m', async () => {
     const server = await startBackend(null, { extra: ['--preset', 'earth'] });
     // the floor of an ocean basin of the earth preset (seed 7), about 3.4 km under the sea (the
     // sea is not drawn with the back-face flag on)
@@ -982,11 +982,11 @@ async function main() {
       lat: 27.9,
       lon: 86.9,
       // (10 km and 100 m are visited over the mountains below)
+      // (a zoom down and back up is step 9's; the suite's time goes to the mountains below)
       stops: [
         { name: 'orbit', height: 12_000_000, orbit: true },
         { name: '2m', height: 2 },
       ],
-      zoom: [20_000, 2_000, 200, 20_000],
       pictures: true,
       // 6.4e6 m to two figures: the camera is 6 367 551 m from the centre
       jitter: 6.36e6,
