@@ -684,7 +684,12 @@ impl Planet {
             }
             let r = p.length();
             let nrm = DVec3::from(m.normals[i].map(f64::from));
-            let mut shade = self.terrain.shader.shade(p, nrm);
+            // A height-field vertex lies on the surface: the shader need not look it up.
+            let mut shade = if self.heightfield.is_some() {
+                self.terrain.shader.shade_on_surface(p, nrm)
+            } else {
+                self.terrain.shader.shade(p, nrm)
+            };
             if let Some((material, strength)) = paint_at(&paints, p) {
                 let paint = self.terrain.shader.shade_material(material, p);
                 let mix = |a: u8, b: u8| (f64::from(a) + (f64::from(b) - f64::from(a)) * strength).round() as u8;

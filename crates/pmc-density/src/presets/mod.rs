@@ -105,6 +105,13 @@ pub trait Shader: Send + Sync {
     /// The shade at world point `p` with unit outward normal `normal`.
     fn shade(&self, p: DVec3, normal: DVec3) -> Shade;
 
+    /// [`Shader::shade`] for a point known to lie on the terrain's surface (a height-field
+    /// vertex): a shader that would look the surface up along `p`'s direction may take `|p|`
+    /// instead. The default is `shade`.
+    fn shade_on_surface(&self, p: DVec3, normal: DVec3) -> Shade {
+        self.shade(p, normal)
+    }
+
     /// The shade of material `material` (an index into [`Terrain::materials`]) at world point
     /// `p`, whatever the terrain would put there (used to paint materials by hand). The default is
     /// a neutral grey; the presets use their palettes. Ids past the material list get the grey.

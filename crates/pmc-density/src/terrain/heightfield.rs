@@ -242,11 +242,17 @@ struct HeightShader {
 
 impl HeightShader {
     fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+        let r = p.length();
+        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        self.material_under(p, normal, self.model.surface(dir))
+    }
+
+    /// The material at `p` under (or on) the surface of radius `h` above it.
+    fn material_under(&self, p: DVec3, normal: DVec3, h: f64) -> u8 {
         let m = &*self.model;
         let r = p.length();
         let dir = if r > 0.0 { p / r } else { DVec3::Y };
         let l_d = m.s.l_d;
-        let h = m.surface(dir);
         if r < h - 1.5 * l_d - m.rock_amp {
             return CAVE;
         }
@@ -286,6 +292,11 @@ impl HeightShader {
 impl Shader for HeightShader {
     fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
         self.palette.shade(self.material(p, normal), p)
+    }
+    /// The surface is `p` itself: no height lookup (a lookup is most of a height-field patch's
+    /// cost).
+    fn shade_on_surface(&self, p: DVec3, normal: DVec3) -> Shade {
+        self.palette.shade(self.material_under(p, normal, p.length()), p)
     }
     fn shade_material(&self, material: u8, p: DVec3) -> Shade {
         self.palette.shade_or_unknown(material, p)
@@ -463,6 +474,36 @@ mod tests {
         assert_eq!(at(d(0.8), -4000.0), DEEP);
         assert_eq!(at(d(0.3), -80.0), SHELF);
         assert!(![DEEP, SHELF, CAVE].contains(&at(d(-0.5), 300.0)));
+    }
+
+    /// A point on the surface shades the same whether the shader looks the surface up or is
+    /// told it lies there (the height-field planet's shortcut).
+    #[test]
+    fn shading_on_the_surface_needs_no_lookup() {
+        struct Waves;
+        impl HeightField for Waves {
+            fn height(&self, dir: DVec3) -> f64 {
+                3000.0 * (dir.x * 9.0).sin() * (dir.z * 7.0).cos() - 500.0
+            }
+            fn bounds(&self) -> (f64, f64) {
+                (-3500.0, 2500.0)
+            }
+        }
+        let field = Arc::new(Waves);
+        let t = heightfield_terrain(field.clone(), spec(), &earth_layout(), 1.0).unwrap();
+        let sea = t.sea_radius.unwrap();
+        let mut kinds = std::collections::BTreeSet::new();
+        for k in 0..3000 {
+            let f = f64::from(k);
+            let d = DVec3::new((f * 0.37).sin(), (f * 0.11).cos(), (f * 0.73).sin() + 0.1).normalize();
+            let p = d * (sea + field.height(d));
+            let up = (d + DVec3::new(0.0, 0.2 * (f * 0.5).sin(), 0.0)).normalize();
+            let a = t.shader.shade(p, up);
+            let b = t.shader.shade_on_surface(p, up);
+            assert_eq!(a, b, "at {p}");
+            kinds.insert(a.material);
+        }
+        assert!(kinds.len() >= 4, "{kinds:?}");
     }
 
     #[test]
