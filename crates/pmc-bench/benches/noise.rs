@@ -1,8 +1,12 @@
 //! The noise kernels: eight gradient-noise evaluations one by one and in one vector call, and a
-//! 6-octave fBm sample with its octaves batched against the same sum written with scalar calls
-//! (the reference, in the same run). Points near Earth radius, where the terrain samples them.
+//! 6-octave fBm sample four ways: over coordinate slices (`Fbm::sample_slices`), point by point
+//! with the octaves batched (`Fbm::sample`), written with one scalar call per octave, and, as
+//! references in the same run, the `simdnoise` (AVX2, f32) and `fastnoise-lite` (f64 inputs)
+//! crates' 6-octave fBm at the same points. Points near Earth radius, where the terrain samples
+//! them; the fBm on the unit sphere at a continent-to-hills frequency.
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use pmc_density::noise::{gradient3, gradient3_x8, Fbm, FbmParams, Lanes8, LANES};
+use fastnoise_lite::{FastNoiseLite, FractalType, NoiseType};
+use pmc_density::noise::{gradient3, gradient3_x8, Fbm, FbmParams, Lanes8, DEFAULT_LACUNARITY, LANES};
 use pmc_geometry::glam::DVec3;
 
 fn points(n: usize) -> Vec<DVec3> {
@@ -18,8 +22,11 @@ fn points(n: usize) -> Vec<DVec3> {
         .collect()
 }
 
+const SAMPLES: usize = 1024;
+const FREQUENCY: f64 = 1.15;
+
 fn noise(c: &mut Criterion) {
-    let pts = points(1024);
+    let pts = points(SAMPLES);
     let mut g = c.benchmark_group("noise");
     g.bench_function("gradient3/scalar/evals=1024", |b| {
         b.iter(|| {
@@ -45,7 +52,19 @@ fn noise(c: &mut Criterion) {
     });
     // 6-octave fBm on the unit sphere at a continent-to-hills frequency.
     let dirs: Vec<DVec3> = pts.iter().map(|p| p.normalize()).collect();
-    let fbm = Fbm::new(7, FbmParams::new(1.15, 6));
+    let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+        dirs.iter().map(|d| d.x).collect(),
+        dirs.iter().map(|d| d.y).collect(),
+        dirs.iter().map(|d| d.z).collect(),
+    );
+    let fbm = Fbm::new(7, FbmParams::new(FREQUENCY, 6));
+    let mut out = vec![0.0; SAMPLES];
+    g.bench_function("fbm6/slices/samples=1024", |b| {
+        b.iter(|| {
+            fbm.sample_slices(&x, &y, &z, &mut out);
+            black_box(out.iter().sum::<f64>())
+        })
+    });
     g.bench_function("fbm6/batched/samples=1024", |b| {
         b.iter(|| {
             let mut s = 0.0;
@@ -55,10 +74,10 @@ fn noise(c: &mut Criterion) {
             black_box(s)
         })
     });
-    // The reference: the same kind of sum with one scalar call per octave.
+    // The same kind of sum with one scalar call per octave.
     let octaves: Vec<(f64, f64, u64, DVec3)> = (0..6)
         .map(|i| {
-            let f = 1.15 * 2.03f64.powi(i);
+            let f = FREQUENCY * 2.03f64.powi(i);
             (f, 0.5f64.powi(i), 1000 + i as u64, DVec3::splat(0.3 * f64::from(i)))
         })
         .collect();
@@ -75,7 +94,61 @@ fn noise(c: &mut Criterion) {
             black_box(s)
         })
     });
+    // References: fastnoise-lite's Perlin fBm (f64 coordinates) and simdnoise's simplex fBm
+    // (f32, eight points per AVX2 call), 6 octaves, the same points and lacunarity.
+    let mut fnl = FastNoiseLite::with_seed(7);
+    fnl.set_noise_type(Some(NoiseType::Perlin));
+    fnl.set_fractal_type(Some(FractalType::FBm));
+    fnl.set_fractal_octaves(Some(6));
+    fnl.set_fractal_lacunarity(Some(DEFAULT_LACUNARITY as f32));
+    fnl.set_frequency(Some(FREQUENCY as f32));
+    g.bench_function("fbm6/fastnoise-lite/samples=1024", |b| {
+        b.iter(|| {
+            let mut s = 0.0f32;
+            for d in &dirs {
+                s += fnl.get_noise_3d(d.x, d.y, d.z);
+            }
+            black_box(s)
+        })
+    });
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        let scaled = |v: &[f64]| -> Vec<f32> { v.iter().map(|c| (c * FREQUENCY) as f32).collect() };
+        let (xs, ys, zs) = (scaled(&x), scaled(&y), scaled(&z));
+        let mut out = vec![0.0f32; SAMPLES];
+        g.bench_function("fbm6/simdnoise-avx2/samples=1024", |b| {
+            b.iter(|| {
+                simdnoise_fbm(&xs, &ys, &zs, &mut out);
+                black_box(out.iter().sum::<f32>())
+            })
+        });
+    }
     g.finish();
+}
+
+/// simdnoise's 6-octave 3D fBm at each point, eight at a time.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+fn simdnoise_fbm(x: &[f32], y: &[f32], z: &[f32], out: &mut [f32]) {
+    use std::arch::x86_64::*;
+    assert!(std::is_x86_feature_detected!("avx2"));
+    for (i, o) in out.chunks_exact_mut(8).enumerate() {
+        let k = i * 8;
+        // SAFETY: AVX2 is present (asserted above); each load and store reads or writes eight
+        // f32 inside the slices (k + 8 <= len, by `chunks_exact_mut` over a slice as long).
+        unsafe {
+            let v = simdnoise::avx2::fbm_3d(
+                _mm256_loadu_ps(x[k..k + 8].as_ptr()),
+                _mm256_loadu_ps(y[k..k + 8].as_ptr()),
+                _mm256_loadu_ps(z[k..k + 8].as_ptr()),
+                _mm256_set1_ps(DEFAULT_LACUNARITY as f32),
+                _mm256_set1_ps(0.5),
+                6,
+                7,
+            );
+            _mm256_storeu_ps(o.as_mut_ptr(), v);
+        }
+    }
 }
 
 criterion_group!(benches, noise);

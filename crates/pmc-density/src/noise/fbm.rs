@@ -3,6 +3,7 @@
 
 #[cfg(test)]
 use super::gradient::gradient3;
+use super::lanes::gradient3_accumulate_offset;
 use super::octave::{octave_noise, table, Octave, MAX_OCTAVES};
 use pmc_geometry::glam::DVec3;
 
@@ -93,10 +94,32 @@ impl Fbm {
         }
         sum * self.norm
     }
+
+    /// The values at many points given as coordinate slices (structure of arrays): `out[i]`
+    /// gets exactly the bits of [`sample`](Self::sample) at `(x[i], y[i], z[i])`.
+    ///
+    /// This is the fast way to sample a field at a chunk's or a patch's points: one octave at a
+    /// time over all of them ([`super::gradient3_accumulate_offset`]), eight points per vector
+    /// operation on processors with AVX-512, with no per-point call or packing.
+    ///
+    /// Panics when the slices differ in length (a caller's bug).
+    pub fn sample_slices(&self, x: &[f64], y: &[f64], z: &[f64], out: &mut [f64]) {
+        assert!(
+            x.len() == out.len() && y.len() == out.len() && z.len() == out.len(),
+            "one output per point"
+        );
+        out.fill(0.0);
+        for o in &self.octaves[..self.count] {
+            gradient3_accumulate_offset(x, y, z, o.frequency, o.offset, o.seed, o.amplitude, out);
+        }
+        for v in out.iter_mut() {
+            *v *= self.norm;
+        }
+    }
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn grid(n: i32, step: f64) -> impl Iterator<Item = DVec3> {
@@ -121,6 +144,51 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Coordinate slices of random points near Earth radius, on lattice planes and at small
+    /// coordinates, of a length that is not a multiple of the lanes.
+    pub(crate) fn slice_points(n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        use crate::noise::{mix64, unit_f64};
+        let mut out = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..n as u64 {
+            let r = |k: u64| unit_f64(mix64(i * 3 + k)) * 2.0 - 1.0;
+            let scale = [1.0, 6.4e6, 3.0e3][(i % 3) as usize];
+            let mut p = DVec3::new(r(0), r(1), r(2)) * scale;
+            if i % 11 == 5 {
+                p.z = p.z.round();
+            }
+            if i % 13 == 7 {
+                p = p.normalize();
+            }
+            out.0.push(p.x);
+            out.1.push(p.y);
+            out.2.push(p.z);
+        }
+        out
+    }
+
+    #[test]
+    fn slices_give_the_point_by_point_bits() {
+        let (x, y, z) = slice_points(1003);
+        for octaves in [1, 2, 6, 9, 16] {
+            let f = Fbm::new(21, FbmParams::new(1.3, octaves));
+            for len in [0, 7, 8, 16, 1003] {
+                let mut out = vec![f64::NAN; len];
+                f.sample_slices(&x[..len], &y[..len], &z[..len], &mut out);
+                for i in 0..len {
+                    let want = f.sample(DVec3::new(x[i], y[i], z[i]));
+                    assert_eq!(out[i].to_bits(), want.to_bits(), "{octaves} octaves, point {i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "one output per point")]
+    fn slices_of_different_lengths_are_refused() {
+        let f = Fbm::new(1, FbmParams::default());
+        f.sample_slices(&[0.0; 4], &[0.0; 4], &[0.0; 3], &mut [0.0; 4]);
     }
 
     #[test]

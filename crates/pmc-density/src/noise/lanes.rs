@@ -84,11 +84,42 @@ pub fn gradient3_accumulate(x: &[f64], y: &[f64], z: &[f64], scale: f64, seed: u
         "one output per point"
     );
     #[cfg(target_arch = "x86_64")]
-    let done = x86::gradient3_accumulate(x, y, z, scale, seed, amp, out);
+    let done = x86::gradient3_accumulate::<false>(x, y, z, scale, DVec3::ZERO, seed, amp, out);
     #[cfg(not(target_arch = "x86_64"))]
     let done = 0;
     for i in done..out.len() {
         out[i] += amp * gradient3(DVec3::new(x[i], y[i], z[i]) * scale, seed);
+    }
+}
+
+/// `out[i] += amp * gradient3((x[i], y[i], z[i]) * scale + offset, seed)` for every `i`, bit for
+/// bit: [`gradient3_accumulate`] with the lattice shifted by `offset` (a multiply, then an add,
+/// as the scalar expression), which is how a fractal sum's octaves sample (each its own scale,
+/// offset and seed). The fractal sums' slice methods ([`super::Fbm::sample_slices`],
+/// [`super::Ridged::sample_slices`]) run one call per octave.
+///
+/// Panics when the four slices differ in length (a caller's bug).
+#[allow(clippy::too_many_arguments)]
+pub fn gradient3_accumulate_offset(
+    x: &[f64],
+    y: &[f64],
+    z: &[f64],
+    scale: f64,
+    offset: DVec3,
+    seed: u64,
+    amp: f64,
+    out: &mut [f64],
+) {
+    assert!(
+        x.len() == out.len() && y.len() == out.len() && z.len() == out.len(),
+        "one output per point"
+    );
+    #[cfg(target_arch = "x86_64")]
+    let done = x86::gradient3_accumulate::<true>(x, y, z, scale, offset, seed, amp, out);
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = 0;
+    for i in done..out.len() {
+        out[i] += amp * gradient3(DVec3::new(x[i], y[i], z[i]) * scale + offset, seed);
     }
 }
 
@@ -105,6 +136,7 @@ pub(crate) mod x86 {
     use super::{Lanes8, LANES};
     use crate::noise::gradient::{GX, GY, GZ, ROUND_MAGIC, SCALE};
     use crate::noise::hash::{FINAL_MUL, LATTICE_X, LATTICE_Y, LATTICE_Z};
+    use pmc_geometry::glam::DVec3;
     use std::arch::x86_64::*;
 
     /// Whether this processor runs the kernel (AVX-512 F and DQ).
@@ -130,12 +162,15 @@ pub(crate) mod x86 {
 
     /// [`super::gradient3_accumulate`] for the leading multiple of eight points; returns how
     /// many were done (0 on a processor without AVX-512 F and DQ).
+    /// With `OFFSET`, the points are shifted by `offset` after scaling.
     #[inline]
-    pub(crate) fn gradient3_accumulate(
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn gradient3_accumulate<const OFFSET: bool>(
         x: &[f64],
         y: &[f64],
         z: &[f64],
         scale: f64,
+        offset: DVec3,
         seed: u64,
         amp: f64,
         out: &mut [f64],
@@ -147,11 +182,12 @@ pub(crate) mod x86 {
         // SAFETY: the processor has AVX-512 F and DQ (checked above); `accumulate_kernel` reads
         // and writes the first `n` entries only, and every slice holds at least `n`.
         unsafe {
-            accumulate_kernel(
+            accumulate_kernel::<OFFSET>(
                 x.as_ptr(),
                 y.as_ptr(),
                 z.as_ptr(),
                 scale,
+                [offset.x, offset.y, offset.z],
                 seed,
                 amp,
                 out.as_mut_ptr(),
@@ -211,26 +247,58 @@ pub(crate) mod x86 {
         }
     }
 
-    /// The contribution of one corner: the hash of its key picks a gradient, dotted with the
-    /// offset `(dx, dy, dz)` as `(gx dx + gy dy) + gz dz`.
+    /// A gradient component `g` (`-1`, `0` or `1`) as a mask `m` for which
+    /// [`times_gradient`]`(d, m)` is exactly the bits of `g * d`: `1` is `0x7FFF_FFFF_FFFF_FFFF`,
+    /// `-1` all ones, `0` all zeros.
+    const fn gradient_masks(g: &[f64; 16]) -> [i64; 16] {
+        let mut out = [0i64; 16];
+        let mut i = 0;
+        while i < 16 {
+            out[i] = if g[i] > 0.0 {
+                i64::MAX
+            } else if g[i] < 0.0 {
+                -1
+            } else {
+                0
+            };
+            i += 1;
+        }
+        out
+    }
+    const MX: [i64; 16] = gradient_masks(&GX);
+    const MY: [i64; 16] = gradient_masks(&GY);
+    const MZ: [i64; 16] = gradient_masks(&GZ);
+
+    /// `g * d` from `g`'s mask `m` (see [`gradient_masks`]), exactly: below the sign bit
+    /// `d & m` (all of `d`, or zero), at the sign bit `d ^ m` (kept or flipped). The product of
+    /// `+0` and a finite `d` is a zero with `d`'s sign, as here. One bitwise operation
+    /// (`c ? a ^ b : a & b` with `c` the sign bit: truth table `0x68`) instead of a
+    /// floating-point multiply.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn corner(
-        key: __m512i,
-        dx: __m512d,
-        dy: __m512d,
-        dz: __m512d,
-        tx: &Table,
-        ty: &Table,
-        tz: &Table,
-    ) -> __m512d {
-        let h = _mm512_mullo_epi64(
-            _mm512_xor_si512(key, _mm512_srli_epi64::<32>(key)),
-            _mm512_set1_epi64(FINAL_MUL as i64),
-        );
-        let idx = _mm512_srli_epi64::<60>(h);
-        let xy = _mm512_add_pd(_mm512_mul_pd(tx.get(idx), dx), _mm512_mul_pd(ty.get(idx), dy));
-        _mm512_add_pd(xy, _mm512_mul_pd(tz.get(idx), dz))
+    unsafe fn times_gradient(d: __m512d, m: __m512i) -> __m512d {
+        let sign = _mm512_set1_epi64(i64::MIN);
+        _mm512_castsi512_pd(_mm512_ternarylogic_epi64::<0x68>(_mm512_castpd_si512(d), m, sign))
+    }
+
+    /// The sixteen gradient masks of one axis, as two registers of eight.
+    struct MaskTable {
+        lo: __m512i,
+        hi: __m512i,
+    }
+
+    impl MaskTable {
+        #[inline(always)]
+        unsafe fn new(v: &[i64; 16]) -> MaskTable {
+            MaskTable {
+                lo: _mm512_loadu_si512(v.as_ptr().cast()),
+                hi: _mm512_loadu_si512(v.as_ptr().add(8).cast()),
+            }
+        }
+        /// Entry `idx` (0..16) of each lane.
+        #[inline(always)]
+        unsafe fn get(&self, idx: __m512i) -> __m512i {
+            _mm512_permutex2var_epi64(self.lo, idx, self.hi)
+        }
     }
 
     #[target_feature(enable = "avx512f,avx512dq")]
@@ -247,11 +315,12 @@ pub(crate) mod x86 {
     /// Points `0..n` (a multiple of eight) of the slices, eight at a time, with one seed.
     #[target_feature(enable = "avx512f,avx512dq")]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn accumulate_kernel(
+    unsafe fn accumulate_kernel<const OFFSET: bool>(
         x: *const f64,
         y: *const f64,
         z: *const f64,
         scale: f64,
+        offset: [f64; 3],
         seed: u64,
         amp: f64,
         out: *mut f64,
@@ -259,12 +328,28 @@ pub(crate) mod x86 {
     ) {
         let seed = _mm512_set1_epi64(seed as i64);
         let (scale, amp) = (_mm512_set1_pd(scale), _mm512_set1_pd(amp));
+        let (ox, oy, oz) = (
+            _mm512_set1_pd(offset[0]),
+            _mm512_set1_pd(offset[1]),
+            _mm512_set1_pd(offset[2]),
+        );
+        // A multiply, then (with an offset) an add: the scalar `p * scale + offset`.
+        macro_rules! place {
+            ($v:expr, $o:expr) => {{
+                let v = _mm512_mul_pd($v, scale);
+                if OFFSET {
+                    _mm512_add_pd(v, $o)
+                } else {
+                    v
+                }
+            }};
+        }
         macro_rules! load {
             ($i:expr) => {
                 [
-                    _mm512_mul_pd(_mm512_loadu_pd(x.add($i)), scale),
-                    _mm512_mul_pd(_mm512_loadu_pd(y.add($i)), scale),
-                    _mm512_mul_pd(_mm512_loadu_pd(z.add($i)), scale),
+                    place!(_mm512_loadu_pd(x.add($i)), ox),
+                    place!(_mm512_loadu_pd(y.add($i)), oy),
+                    place!(_mm512_loadu_pd(z.add($i)), oz),
                 ]
             };
         }
@@ -275,23 +360,35 @@ pub(crate) mod x86 {
             };
         }
         let mut cache = PlaneCache::new();
+        let mut corners = CornerCache::new();
         let mut i = 0;
         // Two groups at a time: their independent chains overlap in the processor.
         while i + 2 * LANES <= n {
             let (p, q) = (load!(i), load!(i + LANES));
-            match eval_planar_x2([p, q], seed, &mut cache) {
+            let groups = [
+                [split(p[0]), split(p[1]), split(p[2])],
+                [split(q[0]), split(q[1]), split(q[2])],
+            ];
+            // Shifted octaves (the fractal sums') have an offset that is no lattice integer, so
+            // their points are not worth testing for a lattice plane.
+            let planar = if OFFSET {
+                None
+            } else {
+                eval_planar_x2(&groups, seed, &mut cache)
+            };
+            match planar {
                 Some([(r, zr), (s, zs)]) => {
                     // A zero's sign is lost in a nonzero sum; where the sum so far is zero too,
                     // the full kernel decides it.
                     let zero = _mm512_setzero_pd();
                     let (o, t) = (_mm512_loadu_pd(out.add(i)), _mm512_loadu_pd(out.add(i + LANES)));
                     let r = if zr & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(o, zero) != 0 {
-                        eval(p[0], p[1], p[2], seed)
+                        eval_cells_cached(groups[0], seed, &mut corners)
                     } else {
                         r
                     };
                     let s = if zs & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(t, zero) != 0 {
-                        eval(q[0], q[1], q[2], seed)
+                        eval_cells_cached(groups[1], seed, &mut corners)
                     } else {
                         s
                     };
@@ -299,8 +396,8 @@ pub(crate) mod x86 {
                     add!(i + LANES, s);
                 }
                 None => {
-                    add!(i, eval(p[0], p[1], p[2], seed));
-                    add!(i + LANES, eval(q[0], q[1], q[2], seed));
+                    add!(i, eval_cells_cached(groups[0], seed, &mut corners));
+                    add!(i + LANES, eval_cells_cached(groups[1], seed, &mut corners));
                 }
             }
             i += 2 * LANES;
@@ -323,15 +420,11 @@ pub(crate) mod x86 {
     /// a nonzero result has the same bits, and a zero one may differ in its sign only.
     #[inline(always)]
     unsafe fn eval_planar_x2(
-        p: [[__m512d; 3]; 2],
+        groups: &[[(__m512i, __m512d); 3]; 2],
         seed: __m512i,
         cache: &mut PlaneCache,
     ) -> Option<[(__m512d, __mmask8); 2]> {
         let zero = _mm512_setzero_pd();
-        let groups = [
-            [split(p[0][0]), split(p[0][1]), split(p[0][2])],
-            [split(p[1][0]), split(p[1][1]), split(p[1][2])],
-        ];
         let flat = |c: usize| {
             (_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(groups[0][c].1, zero)
                 & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(groups[1][c].1, zero))
@@ -443,7 +536,7 @@ pub(crate) mod x86 {
     }
 
     /// The gradient components along a plane's two free axes at the corner with keys `p` and
-    /// `q` along them and `k` (seeded) across: [`corner`]'s hash and table lookups.
+    /// `q` along them and `k` (seeded) across: [`corner_gradients`]' hash and table lookups.
     #[inline(always)]
     unsafe fn plane_gradient(p: __m512i, q: __m512i, k: __m512i, ta: &Table, tb: &Table) -> (__m512d, __m512d) {
         let key = _mm512_xor_si512(_mm512_xor_si512(p, q), k);
@@ -464,9 +557,65 @@ pub(crate) mod x86 {
     /// The eight evaluations of the points `(x, y, z)` with seeds `seed`, lane by lane.
     #[inline(always)]
     unsafe fn eval(x: __m512d, y: __m512d, z: __m512d, seed: __m512i) -> __m512d {
-        let (ix, fx) = split(x);
-        let (iy, fy) = split(y);
-        let (iz, fz) = split(z);
+        eval_cells([split(x), split(y), split(z)], seed)
+    }
+
+    /// [`eval`] from the points' cells and fractions along x, y and z.
+    #[inline(always)]
+    unsafe fn eval_cells(cells: [(__m512i, __m512d); 3], seed: __m512i) -> __m512d {
+        let [(ix, fx), (iy, fy), (iz, fz)] = cells;
+        eval_gradients(&corner_gradients(ix, iy, iz, seed), fx, fy, fz)
+    }
+
+    /// [`eval_cells`] reusing the corner gradients of the last group when every lane lies in
+    /// the same cells as that group's (a batch of nearby points in a coarse octave), else
+    /// computing and keeping them.
+    #[inline(always)]
+    unsafe fn eval_cells_cached(cells: [(__m512i, __m512d); 3], seed: __m512i, cache: &mut CornerCache) -> __m512d {
+        let [(ix, fx), (iy, fy), (iz, fz)] = cells;
+        let hit = cache.valid
+            && (_mm512_cmpeq_epi64_mask(ix, cache.cells[0])
+                & _mm512_cmpeq_epi64_mask(iy, cache.cells[1])
+                & _mm512_cmpeq_epi64_mask(iz, cache.cells[2]))
+                == 0xFF;
+        if !hit {
+            cache.grads = corner_gradients(ix, iy, iz, seed);
+            cache.cells = [ix, iy, iz];
+            cache.valid = true;
+        }
+        eval_gradients(&cache.grads, fx, fy, fz)
+    }
+
+    /// The corner gradients of the last group evaluated with one seed (see
+    /// [`eval_cells_cached`]).
+    pub(super) struct CornerCache {
+        /// Whether `cells` and `grads` hold a group's.
+        valid: bool,
+        /// The lanes' cells along x, y and z.
+        cells: [__m512i; 3],
+        /// The gradient masks `(gx, gy, gz)` of the eight corners, in [`corner_gradients`]'
+        /// order.
+        grads: [[__m512i; 3]; 8],
+    }
+
+    impl CornerCache {
+        #[inline(always)]
+        unsafe fn new() -> CornerCache {
+            let zi = _mm512_setzero_si512();
+            CornerCache {
+                valid: false,
+                cells: [zi; 3],
+                grads: [[zi; 3]; 8],
+            }
+        }
+    }
+
+    /// The gradients `(gx, gy, gz)` of the eight corners of the cells `(ix, iy, iz)`, as masks
+    /// ([`gradient_masks`]), in the order `000, 100, 010, 110, 001, 101, 011, 111` (bits x, y,
+    /// z): each corner's key hashed (`corner_hash`) and its top four bits looked up in the
+    /// gradient tables.
+    #[inline(always)]
+    unsafe fn corner_gradients(ix: __m512i, iy: __m512i, iz: __m512i, seed: __m512i) -> [[__m512i; 3]; 8] {
         let x0 = _mm512_mullo_epi64(ix, _mm512_set1_epi64(LATTICE_X as i64));
         let y0 = _mm512_mullo_epi64(iy, _mm512_set1_epi64(LATTICE_Y as i64));
         let z0 = _mm512_mullo_epi64(iz, _mm512_set1_epi64(LATTICE_Z as i64));
@@ -474,18 +623,57 @@ pub(crate) mod x86 {
         let y1 = _mm512_add_epi64(y0, _mm512_set1_epi64(LATTICE_Y as i64));
         let z1 = _mm512_add_epi64(z0, _mm512_set1_epi64(LATTICE_Z as i64));
         let (y0, y1) = (_mm512_xor_si512(y0, seed), _mm512_xor_si512(y1, seed));
+        let (tx, ty, tz) = (MaskTable::new(&MX), MaskTable::new(&MY), MaskTable::new(&MZ));
+        // The corner keys `x ^ y ^ z` (xor is associative: any grouping gives the same bits),
+        // sharing the four `x ^ y` pairs.
+        let (k00, k10) = (_mm512_xor_si512(x0, y0), _mm512_xor_si512(x1, y0));
+        let (k01, k11) = (_mm512_xor_si512(x0, y1), _mm512_xor_si512(x1, y1));
+        // (Macros, not closures: a closure would be compiled without the kernel's features.)
+        macro_rules! grad {
+            ($xy:expr, $z:expr) => {{
+                let key = _mm512_xor_si512($xy, $z);
+                let h = _mm512_mullo_epi64(
+                    _mm512_xor_si512(key, _mm512_srli_epi64::<32>(key)),
+                    _mm512_set1_epi64(FINAL_MUL as i64),
+                );
+                let idx = _mm512_srli_epi64::<60>(h);
+                [tx.get(idx), ty.get(idx), tz.get(idx)]
+            }};
+        }
+        [
+            grad!(k00, z0),
+            grad!(k10, z0),
+            grad!(k01, z0),
+            grad!(k11, z0),
+            grad!(k00, z1),
+            grad!(k10, z1),
+            grad!(k01, z1),
+            grad!(k11, z1),
+        ]
+    }
+
+    /// The eight lanes' values from their corner gradients (as masks) and fractions: each
+    /// corner's `(gx dx + gy dy) + gz dz` (the products by [`times_gradient`]), the fades, the trilinear blend and the scale, in the scalar
+    /// order.
+    #[inline(always)]
+    unsafe fn eval_gradients(g: &[[__m512i; 3]; 8], fx: __m512d, fy: __m512d, fz: __m512d) -> __m512d {
         let one = _mm512_set1_pd(1.0);
         let (gx, gy, gz) = (_mm512_sub_pd(fx, one), _mm512_sub_pd(fy, one), _mm512_sub_pd(fz, one));
-        let (tx, ty, tz) = (Table::new(&GX), Table::new(&GY), Table::new(&GZ));
-        let key = |a: __m512i, b: __m512i, c: __m512i| _mm512_xor_si512(_mm512_xor_si512(a, b), c);
-        let n000 = corner(key(x0, y0, z0), fx, fy, fz, &tx, &ty, &tz);
-        let n100 = corner(key(x1, y0, z0), gx, fy, fz, &tx, &ty, &tz);
-        let n010 = corner(key(x0, y1, z0), fx, gy, fz, &tx, &ty, &tz);
-        let n110 = corner(key(x1, y1, z0), gx, gy, fz, &tx, &ty, &tz);
-        let n001 = corner(key(x0, y0, z1), fx, fy, gz, &tx, &ty, &tz);
-        let n101 = corner(key(x1, y0, z1), gx, fy, gz, &tx, &ty, &tz);
-        let n011 = corner(key(x0, y1, z1), fx, gy, gz, &tx, &ty, &tz);
-        let n111 = corner(key(x1, y1, z1), gx, gy, gz, &tx, &ty, &tz);
+        macro_rules! dot {
+            ($g:expr, $dx:expr, $dy:expr, $dz:expr) => {{
+                let g = $g;
+                let xy = _mm512_add_pd(times_gradient($dx, g[0]), times_gradient($dy, g[1]));
+                _mm512_add_pd(xy, times_gradient($dz, g[2]))
+            }};
+        }
+        let n000 = dot!(g[0], fx, fy, fz);
+        let n100 = dot!(g[1], gx, fy, fz);
+        let n010 = dot!(g[2], fx, gy, fz);
+        let n110 = dot!(g[3], gx, gy, fz);
+        let n001 = dot!(g[4], fx, fy, gz);
+        let n101 = dot!(g[5], gx, fy, gz);
+        let n011 = dot!(g[6], fx, gy, gz);
+        let n111 = dot!(g[7], gx, gy, gz);
         let (u, v, w) = (fade(fx), fade(fy), fade(fz));
         let a = lerp(v, lerp(u, n000, n100), lerp(u, n010, n110));
         let b = lerp(v, lerp(u, n001, n101), lerp(u, n011, n111));
@@ -542,6 +730,40 @@ mod tests {
                 "{:?} x {scale}, seed {seed}",
                 pts[i]
             );
+        }
+    }
+
+    #[test]
+    fn offset_slices_equal_scalar_calls_bit_for_bit() {
+        let pts: Vec<DVec3> = hard_points(4_005).into_iter().map(|p| p.0).collect();
+        let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+            pts.iter().map(|p| p.x).collect(),
+            pts.iter().map(|p| p.y).collect(),
+            pts.iter().map(|p| p.z).collect(),
+        );
+        let offsets = [
+            DVec3::ZERO,
+            DVec3::new(-0.0, 0.0, -0.0),
+            DVec3::new(517.25, -0.5, 1023.999),
+            DVec3::new(-6.4e6, 3.0, 0.125),
+        ];
+        for (k, offset) in offsets.into_iter().enumerate() {
+            for scale in [1.0, 2.03, 1e-3] {
+                let start: Vec<f64> = (0..pts.len()).map(|i| [0.0, -0.0, 0.5][i % 3]).collect();
+                let (mut got, mut want) = (start.clone(), start);
+                gradient3_accumulate_offset(&x, &y, &z, scale, offset, 99 + k as u64, 0.25, &mut got);
+                for (p, w) in pts.iter().zip(want.iter_mut()) {
+                    *w += 0.25 * gradient3(*p * scale + offset, 99 + k as u64);
+                }
+                for i in 0..pts.len() {
+                    assert_eq!(
+                        got[i].to_bits(),
+                        want[i].to_bits(),
+                        "{:?} x {scale} + {offset:?}",
+                        pts[i]
+                    );
+                }
+            }
         }
     }
 

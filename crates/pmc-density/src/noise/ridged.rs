@@ -3,6 +3,7 @@
 
 #[cfg(test)]
 use super::gradient::gradient3;
+use super::lanes::gradient3_accumulate_offset;
 use super::octave::{octave_noise, table, Octave, MAX_OCTAVES};
 use super::{DEFAULT_FREQUENCY, DEFAULT_GAIN, DEFAULT_LACUNARITY, DEFAULT_OCTAVES};
 use pmc_geometry::glam::DVec3;
@@ -103,11 +104,62 @@ impl Ridged {
         }
         sum * self.norm
     }
+
+    /// The values at many points given as coordinate slices (structure of arrays): `out[i]`
+    /// gets exactly the bits of [`sample`](Self::sample) at `(x[i], y[i], z[i])`, one octave at
+    /// a time over blocks of points (see [`super::Fbm::sample_slices`]).
+    ///
+    /// Panics when the slices differ in length (a caller's bug).
+    pub fn sample_slices(&self, x: &[f64], y: &[f64], z: &[f64], out: &mut [f64]) {
+        assert!(
+            x.len() == out.len() && y.len() == out.len() && z.len() == out.len(),
+            "one output per point"
+        );
+        const BLOCK: usize = 256;
+        let (mut noise, mut weight) = ([0.0; BLOCK], [0.0; BLOCK]);
+        for start in (0..out.len()).step_by(BLOCK) {
+            let end = (start + BLOCK).min(out.len());
+            let (x, y, z, out) = (&x[start..end], &y[start..end], &z[start..end], &mut out[start..end]);
+            let (noise, weight) = (&mut noise[..out.len()], &mut weight[..out.len()]);
+            out.fill(0.0);
+            weight.fill(1.0);
+            for o in &self.octaves[..self.count] {
+                // `0 + 1 n` is `n` (a negative zero becomes a positive one, which `abs` ignores).
+                noise.fill(0.0);
+                gradient3_accumulate_offset(x, y, z, o.frequency, o.offset, o.seed, 1.0, noise);
+                for ((sum, w), n) in out.iter_mut().zip(weight.iter_mut()).zip(noise.iter()) {
+                    let s = self.params.offset - n.abs();
+                    let s = s * s * *w;
+                    *w = (s * self.params.feedback).clamp(0.0, 1.0);
+                    *sum += s * o.amplitude;
+                }
+            }
+            for v in out.iter_mut() {
+                *v *= self.norm;
+            }
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn slices_give_the_point_by_point_bits() {
+        let (x, y, z) = crate::noise::fbm::tests::slice_points(1003);
+        for octaves in [1, 5, 12] {
+            let r = Ridged::new(8, RidgedParams::new(2.1, octaves));
+            for len in [0, 9, 256, 257, 1003] {
+                let mut out = vec![f64::NAN; len];
+                r.sample_slices(&x[..len], &y[..len], &z[..len], &mut out);
+                for i in 0..len {
+                    let want = r.sample(DVec3::new(x[i], y[i], z[i]));
+                    assert_eq!(out[i].to_bits(), want.to_bits(), "{octaves} octaves, point {i}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn batched_octaves_give_the_scalar_sum_bit_for_bit() {
