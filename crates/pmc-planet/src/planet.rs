@@ -662,34 +662,46 @@ impl Planet {
             index.extend(r.previous.edge_keys.iter().enumerate().map(|(j, k)| (*k, j as u32)));
             (r, &*index)
         });
-        for i in 0..n {
-            let p = m.world_position(i);
-            if let Some((r, index)) = &reuse {
+        // Vertices unchanged by the edit take the previous mesh's attributes; the others are
+        // shaded in one batch.
+        let previous: Vec<Option<usize>> = (0..n)
+            .map(|i| {
+                let (r, index) = reuse.as_ref()?;
                 let same = |j: &u32| {
                     let j = *j as usize;
                     let bits = |v: [f32; 3]| v.map(f32::to_bits);
                     bits(r.previous.positions[j]) == bits(m.positions[i])
                         && bits(r.previous.normals[j]) == bits(m.normals[i])
                 };
-                let outside = (p - r.op.center).length() >= r.op.reach();
-                if let Some(j) = index.get(&m.edge_keys[i]).filter(|j| outside && same(j)) {
-                    let j = *j as usize;
-                    let prev = r.previous;
-                    m.heights.push(prev.heights[j]);
-                    m.water_depths.push(prev.water_depths[j]);
-                    m.colors.push(prev.colors[j]);
-                    m.materials.push(prev.materials[j]);
-                    continue;
-                }
+                let outside = (m.world_position(i) - r.op.center).length() >= r.op.reach();
+                index
+                    .get(&m.edge_keys[i])
+                    .filter(|j| outside && same(j))
+                    .map(|j| *j as usize)
+            })
+            .collect();
+        let (points, normals): (Vec<DVec3>, Vec<DVec3>) = (0..n)
+            .filter(|&i| previous[i].is_none())
+            .map(|i| (m.world_position(i), DVec3::from(m.normals[i].map(f64::from))))
+            .unzip();
+        // A height-field vertex lies on the surface: the shader need not look it up.
+        let mut shades = Vec::with_capacity(points.len());
+        self.terrain
+            .shader
+            .shade_many(&points, &normals, self.heightfield.is_some(), &mut shades);
+        let mut shaded = shades.into_iter();
+        for (i, prev) in previous.into_iter().enumerate() {
+            if let (Some(j), Some((r, _))) = (prev, &reuse) {
+                let prev = r.previous;
+                m.heights.push(prev.heights[j]);
+                m.water_depths.push(prev.water_depths[j]);
+                m.colors.push(prev.colors[j]);
+                m.materials.push(prev.materials[j]);
+                continue;
             }
+            let p = m.world_position(i);
             let r = p.length();
-            let nrm = DVec3::from(m.normals[i].map(f64::from));
-            // A height-field vertex lies on the surface: the shader need not look it up.
-            let mut shade = if self.heightfield.is_some() {
-                self.terrain.shader.shade_on_surface(p, nrm)
-            } else {
-                self.terrain.shader.shade(p, nrm)
-            };
+            let mut shade = shaded.next().expect("one shade per vertex to shade");
             if let Some((material, strength)) = paint_at(&paints, p) {
                 let paint = self.terrain.shader.shade_material(material, p);
                 let mix = |a: u8, b: u8| (f64::from(a) + (f64::from(b) - f64::from(a)) * strength).round() as u8;

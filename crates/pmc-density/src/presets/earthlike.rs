@@ -18,7 +18,7 @@
 use super::features::{lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, Overhang, Scales, Spaghetti};
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
-use crate::noise::{derive_seed, gradient3, Fbm, FbmParams, Ridged, RidgedParams};
+use crate::noise::{derive_seed, gradient3, gradient3_accumulate, Fbm, FbmParams, Ridged, RidgedParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -163,27 +163,38 @@ impl EarthModel {
     }
 }
 
-impl ColumnModel for EarthModel {
-    type Column = EarthColumn;
+impl EarthModel {
+    /// The continent value `e` and the land gate of a column from its continent noise.
+    #[inline]
+    fn land(continents: f64) -> (f64, f64) {
+        let e = continents + CONTINENT_BIAS;
+        (e, smoothstep(0.015, 0.07, e))
+    }
 
-    fn column(&self, dir: DVec3) -> EarthColumn {
+    /// The mountain mask from the belt noise (read only where the land gate is open).
+    #[inline]
+    fn mountains(land_gate: f64, belt: impl FnOnce() -> f64) -> f64 {
+        // Mountain belts along the zero set of a low-frequency noise, on land only. The belt and
+        // ridge noises are skipped where their factor is exactly zero.
+        if land_gate > 0.0 {
+            (1.0 - smoothstep(0.02, 0.10, belt().abs())) * land_gate
+        } else {
+            0.0
+        }
+    }
+
+    /// The column along `dir` from its continent value, hill noise and mountain mask, with the
+    /// ridge noise read only where there are mountains.
+    #[inline]
+    fn finish(&self, dir: DVec3, e: f64, hills: f64, mountains: f64, ridge: impl FnOnce() -> f64) -> EarthColumn {
         let t = self.s.thickness;
-        let e = self.continents.sample(dir) + CONTINENT_BIAS;
         // Ocean floor (e < 0) and lowlands (e > 0); both are 0 with zero slope at the coast.
         let ocean = -t * (SHELF_DEPTH * smoothstep(0.0, 0.025, -e) + OCEAN_DEPTH * smoothstep(0.02, 0.16, -e));
         let land = t * LOWLAND_RISE * smoothstep(0.0, 0.25, e);
         let hills_amp = t * lerp(HILLS_SEA, HILLS_LAND, smoothstep(-0.02, 0.05, e));
-        let hills = 2.0 * hills_amp * self.hills.sample(dir);
-        // Mountain belts along the zero set of a low-frequency noise, on land only. The belt and
-        // ridge noises are skipped where their factor is exactly zero.
-        let land_gate = smoothstep(0.015, 0.07, e);
-        let mountains = if land_gate > 0.0 {
-            (1.0 - smoothstep(0.02, 0.10, self.belts.sample(dir).abs())) * land_gate
-        } else {
-            0.0
-        };
+        let hills = 2.0 * hills_amp * hills;
         let (peaks, steep) = if mountains > 0.0 {
-            let ridge = smoothstep(0.35, 0.95, self.ridges.sample(dir));
+            let ridge = smoothstep(0.35, 0.95, ridge());
             (t * MOUNTAIN_HEIGHT * mountains * ridge, smoothstep(0.2, 0.6, ridge))
         } else {
             (0.0, 0.0)
@@ -204,6 +215,59 @@ impl ColumnModel for EarthModel {
             band,
             mountains,
         }
+    }
+}
+
+/// The coordinates of some of `dirs` (those at `idx`), as the slices the fractal sums take.
+fn gather(dirs: &[DVec3], idx: &[usize], xyz: &mut [Vec<f64>; 3]) {
+    for (k, c) in xyz.iter_mut().enumerate() {
+        c.clear();
+        c.extend(idx.iter().map(|&i| dirs[i][k]));
+    }
+}
+
+impl ColumnModel for EarthModel {
+    type Column = EarthColumn;
+
+    fn column(&self, dir: DVec3) -> EarthColumn {
+        let (e, land_gate) = Self::land(self.continents.sample(dir));
+        let hills = self.hills.sample(dir);
+        let mountains = Self::mountains(land_gate, || self.belts.sample(dir));
+        self.finish(dir, e, hills, mountains, || self.ridges.sample(dir))
+    }
+
+    /// The columns of many directions, the same bits as [`column`](Self::column) one by one:
+    /// each fractal sum runs over the coordinate slices of the directions that read it
+    /// ([`Fbm::sample_slices`]), the belts where there is land, the ridges where there are
+    /// mountains.
+    fn columns(&self, dirs: &[DVec3], out: &mut Vec<EarthColumn>) {
+        let n = dirs.len();
+        let all: Vec<usize> = (0..n).collect();
+        let mut xyz = [Vec::new(), Vec::new(), Vec::new()];
+        gather(dirs, &all, &mut xyz);
+        let (mut continents, mut hills) = (vec![0.0; n], vec![0.0; n]);
+        self.continents
+            .sample_slices(&xyz[0], &xyz[1], &xyz[2], &mut continents);
+        self.hills.sample_slices(&xyz[0], &xyz[1], &xyz[2], &mut hills);
+        let land: Vec<(f64, f64)> = continents.iter().map(|c| Self::land(*c)).collect();
+        let gated: Vec<usize> = (0..n).filter(|&i| land[i].1 > 0.0).collect();
+        gather(dirs, &gated, &mut xyz);
+        let mut belts = vec![0.0; gated.len()];
+        self.belts.sample_slices(&xyz[0], &xyz[1], &xyz[2], &mut belts);
+        let mut mountains = vec![0.0; n];
+        for (&i, b) in gated.iter().zip(&belts) {
+            mountains[i] = Self::mountains(land[i].1, || *b);
+        }
+        let ridged: Vec<usize> = (0..n).filter(|&i| mountains[i] > 0.0).collect();
+        gather(dirs, &ridged, &mut xyz);
+        let mut ridges = vec![0.0; n];
+        let mut values = vec![0.0; ridged.len()];
+        self.ridges.sample_slices(&xyz[0], &xyz[1], &xyz[2], &mut values);
+        for (&i, v) in ridged.iter().zip(&values) {
+            ridges[i] = *v;
+        }
+        out.clear();
+        out.extend((0..n).map(|i| self.finish(dirs[i], land[i].0, hills[i], mountains[i], || ridges[i])));
     }
 
     #[inline]
@@ -251,16 +315,27 @@ impl EarthShader {
     }
 
     fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+        let (r, dir) = radial(p);
+        let jitter = || gradient3(self.jitter_point(p), self.jitter_seed);
+        self.material_in(&self.model.column(dir), r, dir, normal, jitter)
+    }
+
+    /// Where the jitter of the height bands samples its noise.
+    #[inline]
+    fn jitter_point(&self, p: DVec3) -> DVec3 {
+        p / (2.0 * self.model.s.tile)
+    }
+
+    /// The material at `r` along `dir` in column `col`, with the height bands' jitter noise
+    /// (read only outside caves).
+    fn material_in(&self, col: &EarthColumn, r: f64, dir: DVec3, normal: DVec3, jitter: impl FnOnce() -> f64) -> u8 {
         let m = &*self.model;
         let (t, l_d, tile) = (m.s.thickness, m.s.l_d, m.s.tile);
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
-        let col = m.column(dir);
         if col.h - r > (1.5 * l_d).max(col.amp + l_d) {
             return CAVE;
         }
         let up = normal.dot(dir);
-        let z = r - m.sea + 0.012 * t * gradient3(p / (2.0 * tile), self.jitter_seed);
+        let z = r - m.sea + 0.012 * t * jitter();
         let snow_line = t * (0.25 - 0.32 * dir.y * dir.y);
         if z > snow_line.max(0.004 * t) && up > 0.5 {
             SNOW
@@ -282,9 +357,41 @@ impl EarthShader {
     }
 }
 
+/// `(|p|, p / |p|)`, with the direction `+y` at the centre.
+#[inline]
+fn radial(p: DVec3) -> (f64, DVec3) {
+    let r = p.length();
+    (r, if r > 0.0 { p / r } else { DVec3::Y })
+}
+
 impl Shader for EarthShader {
     fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
         self.palette.shade(self.material(p, normal), p)
+    }
+
+    /// One batch of columns ([`EarthModel::columns`]) for all the points.
+    fn shade_many(&self, points: &[DVec3], normals: &[DVec3], _on_surface: bool, out: &mut Vec<Shade>) {
+        assert_eq!(points.len(), normals.len(), "one normal per point");
+        let (radii, dirs): (Vec<f64>, Vec<DVec3>) = points.iter().map(|p| radial(*p)).unzip();
+        let mut cols = Vec::with_capacity(points.len());
+        self.model.columns(&dirs, &mut cols);
+        let mut mix = Vec::with_capacity(points.len());
+        self.palette.mix_many(points, &mut mix);
+        // The jitter noise at every point (`0 + 1 n`: a negative zero becomes a positive one,
+        // which leaves `z` unchanged).
+        let q: Vec<DVec3> = points.iter().map(|p| self.jitter_point(*p)).collect();
+        let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+            q.iter().map(|p| p.x).collect(),
+            q.iter().map(|p| p.y).collect(),
+            q.iter().map(|p| p.z).collect(),
+        );
+        let mut jitter = vec![0.0; points.len()];
+        gradient3_accumulate(&x, &y, &z, 1.0, self.jitter_seed, 1.0, &mut jitter);
+        out.clear();
+        out.extend((0..points.len()).map(|i| {
+            let material = self.material_in(&cols[i], radii[i], dirs[i], normals[i], || jitter[i]);
+            self.palette.shade_mixed(material, mix[i])
+        }));
     }
     fn shade_material(&self, material: u8, p: DVec3) -> Shade {
         self.palette.shade_or_unknown(material, p)
@@ -405,6 +512,48 @@ mod tests {
             }
         }
         assert!(folded > 5, "overhangs: {folded}");
+    }
+
+    /// The batched columns and shades are the point-by-point ones, bit for bit: over the whole
+    /// sphere (sea, land, belts and mountains) and at points above, on and below the surface.
+    #[test]
+    fn batches_give_the_point_by_point_bits() {
+        let (ter, m) = terrain(5);
+        let dirs = sphere_dirs(3001);
+        let mut cols = Vec::new();
+        m.columns(&dirs, &mut cols);
+        assert!(cols.iter().any(|c| c.mountains > 0.0) && cols.iter().any(|c| c.h < m.sea()));
+        let bits = |c: &EarthColumn| {
+            (
+                c.h.to_bits(),
+                c.amp.to_bits(),
+                c.mountains.to_bits(),
+                format!("{:?}", c.band),
+            )
+        };
+        for (d, c) in dirs.iter().zip(&cols) {
+            assert_eq!(bits(c), bits(&m.column(*d)), "column at {d:?}");
+        }
+        let (points, normals): (Vec<DVec3>, Vec<DVec3>) = dirs
+            .iter()
+            .zip(&cols)
+            .enumerate()
+            .map(|(i, (d, c))| {
+                let r = c.h + [-30.0, -2.0, 0.0, 1.5][i % 4] * m.s.l_d;
+                let n = (*d + DVec3::new(0.3, -0.2, 0.1) * (i % 3) as f64).normalize();
+                (*d * r, n)
+            })
+            .unzip();
+        let mut shades = Vec::new();
+        ter.shader.shade_many(&points, &normals, false, &mut shades);
+        for i in 0..points.len() {
+            assert_eq!(
+                shades[i],
+                ter.shader.shade(points[i], normals[i]),
+                "shade at {:?}",
+                points[i]
+            );
+        }
     }
 
     #[test]

@@ -83,6 +83,13 @@ pub(crate) trait ColumnModel: Send + Sync + 'static {
     type Column;
     /// The column along unit direction `dir`.
     fn column(&self, dir: DVec3) -> Self::Column;
+    /// The columns along many unit directions into `out` (cleared first): the same values as
+    /// [`column`](Self::column) one by one. Models whose columns sum noise override it to sample
+    /// each fractal sum over all the directions at once.
+    fn columns(&self, dirs: &[DVec3], out: &mut Vec<Self::Column>) {
+        out.clear();
+        out.extend(dirs.iter().map(|d| self.column(*d)));
+    }
     /// The density at `p = dir * r` (with `r = |p|`) in that column.
     fn voxel(&self, col: &Self::Column, dir: DVec3, p: DVec3, r: f64) -> f64;
     /// Sound radial bounds (see [`Density::radial_bounds`]).
@@ -107,11 +114,12 @@ impl<M: ColumnModel> Density for ColumnDensity<M> {
     fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
         assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
         let n = dirs.len();
-        for (d, dir) in dirs.iter().enumerate() {
-            let col = self.0.column(*dir);
+        let mut cols = Vec::with_capacity(n);
+        self.0.columns(dirs, &mut cols);
+        for (d, (dir, col)) in dirs.iter().zip(&cols).enumerate() {
             for (k, r) in radii.iter().enumerate() {
                 let p = *dir * *r;
-                out[k * n + d] = self.0.voxel(&col, *dir, p, p.length()) as f32;
+                out[k * n + d] = self.0.voxel(col, *dir, p, p.length()) as f32;
             }
         }
     }

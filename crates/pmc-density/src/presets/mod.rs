@@ -112,6 +112,25 @@ pub trait Shader: Send + Sync {
         self.shade(p, normal)
     }
 
+    /// The shades at many points: `out[i]` (after `out` is cleared) is
+    /// [`shade`](Self::shade)`(points[i], normals[i])`, or with `on_surface`
+    /// [`shade_on_surface`](Self::shade_on_surface), the same values as one call per point.
+    /// Shaders that look noise up at each point override it to sample the noise over all the
+    /// points at once (a chunk's vertices).
+    ///
+    /// Panics when the slices differ in length (a caller's bug).
+    fn shade_many(&self, points: &[DVec3], normals: &[DVec3], on_surface: bool, out: &mut Vec<Shade>) {
+        assert_eq!(points.len(), normals.len(), "one normal per point");
+        out.clear();
+        out.extend(points.iter().zip(normals).map(|(p, n)| {
+            if on_surface {
+                self.shade_on_surface(*p, *n)
+            } else {
+                self.shade(*p, *n)
+            }
+        }));
+    }
+
     /// The shade of material `material` (an index into [`Terrain::materials`]) at world point
     /// `p`, whatever the terrain would put there (used to paint materials by hand). The default is
     /// a neutral grey; the presets use their palettes. Ids past the material list get the grey.

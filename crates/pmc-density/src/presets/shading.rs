@@ -68,6 +68,31 @@ impl Palette {
         (0.5 + 2.5 * self.mix.sample(p * self.inv_len)).clamp(0.0, 1.0)
     }
 
+    /// [`mix_at`](Self::mix_at) at many points into `out` (cleared first), the same values,
+    /// with the mixing noise sampled over all the points at once.
+    pub fn mix_many(&self, points: &[DVec3], out: &mut Vec<f64>) {
+        let q: Vec<DVec3> = points.iter().map(|p| *p * self.inv_len).collect();
+        let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+            q.iter().map(|p| p.x).collect(),
+            q.iter().map(|p| p.y).collect(),
+            q.iter().map(|p| p.z).collect(),
+        );
+        out.clear();
+        out.resize(points.len(), 0.0);
+        self.mix.sample_slices(&x, &y, &z, out);
+        for v in out.iter_mut() {
+            *v = (0.5 + 2.5 * *v).clamp(0.0, 1.0);
+        }
+    }
+
+    /// The shade of material `id` with mix value `mix` (from [`mix_at`](Self::mix_at)).
+    pub fn shade_mixed(&self, id: u8, mix: f64) -> Shade {
+        Shade {
+            color: self.materials[usize::from(id)].color(mix),
+            material: id,
+        }
+    }
+
     /// The shade of material `id` at `p`; ids past the palette get [`super::UNKNOWN_MATERIAL_COLOR`].
     pub fn shade_or_unknown(&self, id: u8, p: DVec3) -> Shade {
         if usize::from(id) < self.materials.len() {
@@ -82,10 +107,7 @@ impl Palette {
 
     /// The shade of material `id` at `p`.
     pub fn shade(&self, id: u8, p: DVec3) -> Shade {
-        Shade {
-            color: self.materials[usize::from(id)].color(self.mix_at(p)),
-            material: id,
-        }
+        self.shade_mixed(id, self.mix_at(p))
     }
 }
 
