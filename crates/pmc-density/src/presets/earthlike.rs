@@ -15,7 +15,9 @@
 //! | overhangs          | displacement up to 4 `l_d` (at most 0.065 T), on steep mountain slopes | 3 tiles across, 3 `l_d` deep |
 //! | caves              | band from sea level + `l_d` to 2.5 `l_d` under the surface, at most 0.14 T deep; the roof opens in places (cave mouths) | tubes about 2 tiles wide and 3 `l_d` tall, about 12 tiles apart |
 
-use super::features::{lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, Overhang, Scales, Spaghetti};
+use super::features::{
+    lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales, Spaghetti,
+};
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
 use crate::noise::{derive_seed, gradient3, gradient3_accumulate, Fbm, FbmParams, Ridged, RidgedParams};
@@ -274,6 +276,53 @@ impl ColumnModel for EarthModel {
     fn voxel(&self, col: &EarthColumn, dir: DVec3, _p: DVec3, r: f64) -> f64 {
         let d0 = self.overhang.displace(col.h, col.amp, dir, r);
         self.caves.carve(d0, &col.band, dir, r)
+    }
+
+    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits: first the
+    /// displaced terrain everywhere, with the displacement noise of the voxels in an overhang's
+    /// window sampled at once, then the tubes' two noises at once where they can carve.
+    fn voxels(&self, cols: &[EarthColumn], dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        let n = dirs.len();
+        let mut d0 = vec![0.0; n * radii.len()];
+        let mut rs = vec![0.0; n * radii.len()];
+        let (mut noise, mut at) = (NoiseBatch::default(), Vec::new());
+        for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
+            for (k, r) in radii.iter().enumerate() {
+                let i = k * n + d;
+                let r = (*dir * *r).length();
+                let (base, weight) = self.overhang.window(col.h, col.amp, r);
+                (rs[i], d0[i]) = (r, base);
+                if let Some(aw) = weight {
+                    noise.push(self.overhang.point(*dir, r));
+                    at.push((i, aw));
+                }
+            }
+        }
+        let mut values = Vec::new();
+        noise.values(self.overhang.seed(), &mut values);
+        for (&(i, aw), v) in at.iter().zip(&values) {
+            d0[i] += aw * v;
+        }
+        let (mut noise, mut at) = (NoiseBatch::default(), Vec::new());
+        for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
+            for k in 0..radii.len() {
+                let i = k * n + d;
+                if let Some(pen) = self.caves.penalty(d0[i], &col.band, rs[i]) {
+                    noise.push(self.caves.point(*dir, rs[i]));
+                    at.push((i, pen));
+                }
+            }
+        }
+        let (seed_a, seed_b) = self.caves.seeds();
+        let (mut n1, mut n2) = (Vec::new(), Vec::new());
+        noise.values(seed_a, &mut n1);
+        noise.values(seed_b, &mut n2);
+        for (j, &(i, pen)) in at.iter().enumerate() {
+            d0[i] = self.caves.carve_with(d0[i], pen, n1[j], n2[j]);
+        }
+        for (o, v) in out.iter_mut().zip(&d0) {
+            *o = *v as f32;
+        }
     }
 
     fn bounds(&self) -> (f64, f64) {
@@ -544,6 +593,19 @@ mod tests {
                 (*d * r, n)
             })
             .unzip();
+        // Voxels from deep under to high above the surface (caves, overhangs, open air).
+        let radii: Vec<f64> = (0..48)
+            .map(|k| m.sea() - 0.3 * m.s.thickness + f64::from(k) * 0.014 * m.s.thickness)
+            .collect();
+        let mut got = vec![0.0f32; dirs.len() * radii.len()];
+        m.voxels(&cols, &dirs, &radii, &mut got);
+        for (k, r) in radii.iter().enumerate() {
+            for (d, dir) in dirs.iter().enumerate() {
+                let p = *dir * *r;
+                let want = m.voxel(&cols[d], *dir, p, p.length()) as f32;
+                assert_eq!(got[k * dirs.len() + d].to_bits(), want.to_bits(), "voxel at {p:?}");
+            }
+        }
         let mut shades = Vec::new();
         ter.shader.shade_many(&points, &normals, false, &mut shades);
         for i in 0..points.len() {

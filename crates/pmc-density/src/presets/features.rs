@@ -12,7 +12,7 @@
 //! - The cave field has a lower bound that needs no noise, `-t S + P(r)`. Where that bound is at
 //!   least `D0`, `min(D0, C) = D0`.
 
-use crate::noise::{gradient3, gradient3_pair, octaves_for, DEFAULT_LACUNARITY};
+use crate::noise::{gradient3, gradient3_accumulate, gradient3_pair, octaves_for, DEFAULT_LACUNARITY};
 use crate::Density;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
@@ -92,6 +92,19 @@ pub(crate) trait ColumnModel: Send + Sync + 'static {
     }
     /// The density at `p = dir * r` (with `r = |p|`) in that column.
     fn voxel(&self, col: &Self::Column, dir: DVec3, p: DVec3, r: f64) -> f64;
+    /// The densities of a chunk's columns `cols` (along `dirs`) at every radius of `radii`:
+    /// `out[k * dirs.len() + d]` is `voxel(cols[d], dirs[d], p, |p|) as f32` with
+    /// `p = dirs[d] * radii[k]`, the same bits. Models whose voxels read noise override it to
+    /// sample the noise of all the voxels that need it at once.
+    fn voxels(&self, cols: &[Self::Column], dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        let n = dirs.len();
+        for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
+            for (k, r) in radii.iter().enumerate() {
+                let p = *dir * *r;
+                out[k * n + d] = self.voxel(col, *dir, p, p.length()) as f32;
+            }
+        }
+    }
     /// Sound radial bounds (see [`Density::radial_bounds`]).
     fn bounds(&self) -> (f64, f64);
 }
@@ -116,12 +129,7 @@ impl<M: ColumnModel> Density for ColumnDensity<M> {
         let n = dirs.len();
         let mut cols = Vec::with_capacity(n);
         self.0.columns(dirs, &mut cols);
-        for (d, (dir, col)) in dirs.iter().zip(&cols).enumerate() {
-            for (k, r) in radii.iter().enumerate() {
-                let p = *dir * *r;
-                out[k * n + d] = self.0.voxel(col, *dir, p, p.length()) as f32;
-            }
-        }
+        self.0.voxels(&cols, dirs, radii, out);
     }
 
     fn radial_bounds(&self) -> Option<(f64, f64)> {
@@ -153,6 +161,36 @@ impl Stretch {
     #[inline]
     pub fn at(&self, dir: DVec3, r: f64) -> DVec3 {
         dir * (self.r0_h + (r - self.r0) * self.inv_v)
+    }
+}
+
+/// Points at which one noise field is wanted, gathered as coordinate slices, with the noise
+/// then evaluated over all of them at once ([`gradient3_accumulate`], eight per vector
+/// operation).
+#[derive(Default)]
+pub(crate) struct NoiseBatch {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+}
+
+impl NoiseBatch {
+    /// Adds a point; returns its index.
+    #[inline]
+    pub fn push(&mut self, p: DVec3) -> usize {
+        self.x.push(p.x);
+        self.y.push(p.y);
+        self.z.push(p.z);
+        self.x.len() - 1
+    }
+
+    /// `gradient3(point, seed)` at every point, in order, except that a negative zero comes out
+    /// as a positive one (`0 + 1 n`): for callers that square the value or add it, scaled, to a
+    /// nonzero sum.
+    pub fn values(&self, seed: u64, out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(self.x.len(), 0.0);
+        gradient3_accumulate(&self.x, &self.y, &self.z, 1.0, seed, 1.0, out);
     }
 }
 
@@ -230,12 +268,39 @@ impl Spaghetti {
     /// `min(d0, C)` at radius `r` along `dir`, evaluating noise only where `C < d0` is possible.
     #[inline]
     pub fn carve(&self, d0: f64, band: &CaveBand, dir: DVec3, r: f64) -> f64 {
+        match self.penalty(d0, band, r) {
+            None => d0,
+            Some(pen) => {
+                let (n1, n2) = gradient3_pair(self.point(dir, r), self.seed_a, self.seed_b);
+                self.carve_with(d0, pen, n1, n2)
+            }
+        }
+    }
+
+    /// The band's penalty at radius `r` when the tubes can go below `d0` there (their noise is
+    /// needed), `None` when [`carve`](Self::carve) gives `d0` without noise.
+    #[inline]
+    pub fn penalty(&self, d0: f64, band: &CaveBand, r: f64) -> Option<f64> {
         let pen = self.slope * ((r - band.mid).abs() - band.half).max(0.0);
         // sqrt(..) >= 0, so C >= -t S + pen (the operations are monotone, also when rounded).
-        if self.neg_ts + pen >= d0 {
-            return d0;
-        }
-        let (n1, n2) = gradient3_pair(self.stretch.at(dir, r), self.seed_a, self.seed_b);
+        (self.neg_ts + pen < d0).then_some(pen)
+    }
+
+    /// Where the two tube noises are sampled at radius `r` along `dir`.
+    #[inline]
+    pub fn point(&self, dir: DVec3, r: f64) -> DVec3 {
+        self.stretch.at(dir, r)
+    }
+
+    /// The seeds of the two tube noises.
+    pub fn seeds(&self) -> (u64, u64) {
+        (self.seed_a, self.seed_b)
+    }
+
+    /// [`carve`](Self::carve) from the penalty and the two noise values (whose zero signs do
+    /// not matter: they are squared).
+    #[inline]
+    pub fn carve_with(&self, d0: f64, pen: f64, n1: f64, n2: f64) -> f64 {
         let c = ((n1 * n1 + n2 * n2).sqrt() - self.threshold) * self.scale + pen;
         d0.min(c)
     }
@@ -278,18 +343,40 @@ impl Overhang {
     /// The displaced terrain at radius `r` of a column with surface `h` and amplitude `a >= 0`.
     #[inline]
     pub fn displace(&self, h: f64, a: f64, dir: DVec3, r: f64) -> f64 {
+        let (base, weight) = self.window(h, a, r);
+        match weight {
+            None => base,
+            Some(aw) => base + aw * gradient3(self.point(dir, r), self.seed),
+        }
+    }
+
+    /// `h - r` and, where the displacement can change it, its weight `a w` (the noise is then
+    /// needed: the displaced value is `base + a w n`, and a zero `n`'s sign does not change it).
+    #[inline]
+    pub fn window(&self, h: f64, a: f64, r: f64) -> (f64, Option<f64>) {
         let base = h - r;
         if a <= 0.0 {
-            return base;
+            return (base, None);
         }
         let reach = a + (0.5 * a + self.min_falloff);
         let z = base.abs();
         if z >= reach {
             // w = 1 - smoothstep(a, reach, z) = 0: the formula gives base + 0.
-            return base;
+            return (base, None);
         }
         let w = 1.0 - smoothstep(a, reach, z);
-        base + a * w * gradient3(self.stretch.at(dir, r), self.seed)
+        (base, Some(a * w))
+    }
+
+    /// Where the displacement noise is sampled at radius `r` along `dir`.
+    #[inline]
+    pub fn point(&self, dir: DVec3, r: f64) -> DVec3 {
+        self.stretch.at(dir, r)
+    }
+
+    /// The seed of the displacement noise.
+    pub fn seed(&self) -> u64 {
+        self.seed
     }
 
     /// The full formula with no shortcuts (for tests).
