@@ -188,7 +188,7 @@ impl EarthModel {
     /// The column along `dir` from its continent value, hill noise and mountain mask, with the
     /// ridge noise read only where there are mountains.
     #[inline]
-    fn finish(&self, dir: DVec3, e: f64, hills: f64, mountains: f64, ridge: impl FnOnce() -> f64) -> EarthColumn {
+    fn finish(&self, e: f64, hills: f64, mountains: f64, ridge: impl FnOnce() -> f64, region: f64) -> EarthColumn {
         let t = self.s.thickness;
         // Ocean floor (e < 0) and lowlands (e > 0); both are 0 with zero slope at the coast.
         let ocean = -t * (SHELF_DEPTH * smoothstep(0.0, 0.025, -e) + OCEAN_DEPTH * smoothstep(0.02, 0.16, -e));
@@ -204,8 +204,8 @@ impl EarthModel {
         let h = self.sea + ocean + land + hills + peaks;
         let amp = self.overhang_amp * mountains * steep;
         // Caves: between sea level and a roof under the surface, in regions; where the region
-        // noise is high the roof goes above the surface, so tubes open as cave mouths.
-        let region = gradient3(dir * self.region_freq, self.region_seed);
+        // noise is high the roof goes above the surface, so tubes open as cave mouths (the
+        // sign of a zero region value changes neither ramp).
         let gate = smoothstep(-0.25, -0.05, region);
         let mouth = smoothstep(0.15, 0.35, region);
         let roof = self.s.l_d * (CAVE_ROOF - 5.0 * mouth);
@@ -217,6 +217,14 @@ impl EarthModel {
             band,
             mountains,
         }
+    }
+}
+
+impl EarthModel {
+    /// Where the cave-region noise is sampled along `dir`.
+    #[inline]
+    fn region_point(&self, dir: DVec3) -> DVec3 {
+        dir * self.region_freq
     }
 }
 
@@ -235,7 +243,8 @@ impl ColumnModel for EarthModel {
         let (e, land_gate) = Self::land(self.continents.sample(dir));
         let hills = self.hills.sample(dir);
         let mountains = Self::mountains(land_gate, || self.belts.sample(dir));
-        self.finish(dir, e, hills, mountains, || self.ridges.sample(dir))
+        let region = gradient3(self.region_point(dir), self.region_seed);
+        self.finish(e, hills, mountains, || self.ridges.sample(dir), region)
     }
 
     /// The columns of many directions, the same bits as [`column`](Self::column) one by one:
@@ -269,7 +278,13 @@ impl ColumnModel for EarthModel {
             ridges[i] = *v;
         }
         out.clear();
-        out.extend((0..n).map(|i| self.finish(dirs[i], land[i].0, hills[i], mountains[i], || ridges[i])));
+        let mut noise = NoiseBatch::default();
+        for d in dirs {
+            noise.push(self.region_point(*d));
+        }
+        let mut regions = Vec::new();
+        noise.values(self.region_seed, &mut regions);
+        out.extend((0..n).map(|i| self.finish(land[i].0, hills[i], mountains[i], || ridges[i], regions[i])));
     }
 
     #[inline]
@@ -278,50 +293,52 @@ impl ColumnModel for EarthModel {
         self.caves.carve(d0, &col.band, dir, r)
     }
 
-    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits: first the
-    /// displaced terrain everywhere, with the displacement noise of the voxels in an overhang's
-    /// window sampled at once, then the tubes' two noises at once where they can carve.
+    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits, one layer of
+    /// radius at a time: first the displaced terrain everywhere, with the displacement noise of
+    /// the voxels in an overhang's window sampled at once, then the tubes' two noises at once
+    /// where they can carve.
     fn voxels(&self, cols: &[EarthColumn], dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
         let n = dirs.len();
-        let mut d0 = vec![0.0; n * radii.len()];
-        let mut rs = vec![0.0; n * radii.len()];
+        let (mut d0, mut rs) = (vec![0.0; n], vec![0.0; n]);
         let (mut noise, mut at) = (NoiseBatch::default(), Vec::new());
-        for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
-            for (k, r) in radii.iter().enumerate() {
-                let i = k * n + d;
+        let (mut n1, mut n2) = (Vec::new(), Vec::new());
+        let (seed_a, seed_b) = self.caves.seeds();
+        for (k, r) in radii.iter().enumerate() {
+            noise.clear();
+            at.clear();
+            for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
                 let r = (*dir * *r).length();
                 let (base, weight) = self.overhang.window(col.h, col.amp, r);
-                (rs[i], d0[i]) = (r, base);
+                (rs[d], d0[d]) = (r, base);
                 if let Some(aw) = weight {
                     noise.push(self.overhang.point(*dir, r));
-                    at.push((i, aw));
+                    at.push((d, aw));
                 }
             }
-        }
-        let mut values = Vec::new();
-        noise.values(self.overhang.seed(), &mut values);
-        for (&(i, aw), v) in at.iter().zip(&values) {
-            d0[i] += aw * v;
-        }
-        let (mut noise, mut at) = (NoiseBatch::default(), Vec::new());
-        for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
-            for k in 0..radii.len() {
-                let i = k * n + d;
-                if let Some(pen) = self.caves.penalty(d0[i], &col.band, rs[i]) {
-                    noise.push(self.caves.point(*dir, rs[i]));
-                    at.push((i, pen));
+            if !at.is_empty() {
+                noise.values(self.overhang.seed(), &mut n1);
+                for (&(d, aw), v) in at.iter().zip(&n1) {
+                    d0[d] += aw * v;
                 }
             }
-        }
-        let (seed_a, seed_b) = self.caves.seeds();
-        let (mut n1, mut n2) = (Vec::new(), Vec::new());
-        noise.values(seed_a, &mut n1);
-        noise.values(seed_b, &mut n2);
-        for (j, &(i, pen)) in at.iter().enumerate() {
-            d0[i] = self.caves.carve_with(d0[i], pen, n1[j], n2[j]);
-        }
-        for (o, v) in out.iter_mut().zip(&d0) {
-            *o = *v as f32;
+            noise.clear();
+            at.clear();
+            for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
+                if let Some(pen) = self.caves.penalty(d0[d], &col.band, rs[d]) {
+                    noise.push(self.caves.point(*dir, rs[d]));
+                    at.push((d, pen));
+                }
+            }
+            if !at.is_empty() {
+                noise.values(seed_a, &mut n1);
+                noise.values(seed_b, &mut n2);
+                for (j, &(d, pen)) in at.iter().enumerate() {
+                    d0[d] = self.caves.carve_with(d0[d], pen, n1[j], n2[j]);
+                }
+            }
+            for (o, v) in out[k * n..(k + 1) * n].iter_mut().zip(&d0) {
+                *o = *v as f32;
+            }
         }
     }
 
@@ -366,7 +383,14 @@ impl EarthShader {
     fn material(&self, p: DVec3, normal: DVec3) -> u8 {
         let (r, dir) = radial(p);
         let jitter = || gradient3(self.jitter_point(p), self.jitter_seed);
-        self.material_in(&self.model.column(dir), r, dir, normal, jitter)
+        let forest = || gradient3(self.forest_point(dir), self.forest_seed);
+        self.material_in(&self.model.column(dir), r, dir, normal, jitter, forest)
+    }
+
+    /// Where the forest noise is sampled along `dir`.
+    #[inline]
+    fn forest_point(&self, dir: DVec3) -> DVec3 {
+        dir * self.model.s.freq(8.0 * self.model.s.tile)
     }
 
     /// Where the jitter of the height bands samples its noise.
@@ -377,7 +401,16 @@ impl EarthShader {
 
     /// The material at `r` along `dir` in column `col`, with the height bands' jitter noise
     /// (read only outside caves).
-    fn material_in(&self, col: &EarthColumn, r: f64, dir: DVec3, normal: DVec3, jitter: impl FnOnce() -> f64) -> u8 {
+    #[allow(clippy::too_many_arguments)]
+    fn material_in(
+        &self,
+        col: &EarthColumn,
+        r: f64,
+        dir: DVec3,
+        normal: DVec3,
+        jitter: impl FnOnce() -> f64,
+        forest: impl FnOnce() -> f64,
+    ) -> u8 {
         let m = &*self.model;
         let (t, l_d, tile) = (m.s.thickness, m.s.l_d, m.s.tile);
         if col.h - r > (1.5 * l_d).max(col.amp + l_d) {
@@ -393,7 +426,7 @@ impl EarthShader {
         } else if z < 0.012 * t {
             SAND
         } else if z < 0.10 * t {
-            if gradient3(dir * m.s.freq(8.0 * tile), self.forest_seed) > 0.05 {
+            if forest() > 0.05 {
                 FOREST
             } else {
                 GRASS
@@ -436,9 +469,16 @@ impl Shader for EarthShader {
         );
         let mut jitter = vec![0.0; points.len()];
         gradient3_accumulate(&x, &y, &z, 1.0, self.jitter_seed, 1.0, &mut jitter);
+        // The forest noise everywhere (only compared with a positive threshold).
+        let mut noise = NoiseBatch::default();
+        for d in &dirs {
+            noise.push(self.forest_point(*d));
+        }
+        let mut forest = Vec::new();
+        noise.values(self.forest_seed, &mut forest);
         out.clear();
         out.extend((0..points.len()).map(|i| {
-            let material = self.material_in(&cols[i], radii[i], dirs[i], normals[i], || jitter[i]);
+            let material = self.material_in(&cols[i], radii[i], dirs[i], normals[i], || jitter[i], || forest[i]);
             self.palette.shade_mixed(material, mix[i])
         }));
     }

@@ -175,6 +175,13 @@ pub(crate) struct NoiseBatch {
 }
 
 impl NoiseBatch {
+    /// Forgets the points (keeping the memory).
+    pub fn clear(&mut self) {
+        self.x.clear();
+        self.y.clear();
+        self.z.clear();
+    }
+
     /// Adds a point; returns its index.
     #[inline]
     pub fn push(&mut self, p: DVec3) -> usize {
