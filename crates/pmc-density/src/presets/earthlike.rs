@@ -412,7 +412,7 @@ impl EarthShader {
         forest: impl FnOnce() -> f64,
     ) -> u8 {
         let m = &*self.model;
-        let (t, l_d, tile) = (m.s.thickness, m.s.l_d, m.s.tile);
+        let (t, l_d) = (m.s.thickness, m.s.l_d);
         if col.h - r > (1.5 * l_d).max(col.amp + l_d) {
             return CAVE;
         }
