@@ -3,7 +3,7 @@
 //! - [`cube_to_sphere`] and [`sphere_to_cube`]: Eq. (1) and its exact inverse.
 //! - [`Face`]: the six faces with their local frames (two face axes and the outward depth axis).
 //! - [`FaceTransition`]: Algorithm 1, positions and directions between adjacent faces.
-//! - [`LatLon`]: geographic coordinates.
+//! - [`LatLon`], [`Place`]: geographic coordinates, and their text forms `LAT,LON[,ALT]`.
 //! - [`Layout`]: the parameters `n_c, n_t, d_b, l_d, d_c` and Eq. (2)-(4).
 //! - [`ChunkKey`], [`VoxelKey`], [`EdgeKey`]: chunk identity and canonical voxel identity.
 //! - [`ChunkGrid`]: where one chunk samples, with the overlap and padding contract.
@@ -38,5 +38,5 @@ pub use face::{Face, FaceAxis, FaceFrame};
 pub use face_conversion::{convert_axis, AxisMap, FaceTransition};
 pub use glam;
 pub use keys::{ChunkKey, ChunkSide, EdgeKey, SideMask, VoxelKey};
-pub use latlon::{LatLon, LatLonError};
+pub use latlon::{LatLon, LatLonError, Place, PlaceParseError};
 pub use layout::{face_lattice, FaceGrid, Layout, LayoutError, MAX_AXIS_TILES, MAX_CHUNK_TILES};
