@@ -5,7 +5,8 @@
 //! - [`FaceTransition`]: Algorithm 1, positions and directions between adjacent faces.
 //! - [`LatLon`], [`Place`]: geographic coordinates, and their text forms `LAT,LON[,ALT]`.
 //! - [`Layout`]: the parameters `n_c, n_t, d_b, l_d, d_c` and Eq. (2)-(4).
-//! - [`ChunkKey`], [`VoxelKey`], [`EdgeKey`]: chunk identity and canonical voxel identity.
+//! - [`ChunkKey`] (text form `face/level/i/j/k`), [`VoxelKey`], [`EdgeKey`]: chunk identity and
+//!   canonical voxel identity.
 //! - [`ChunkGrid`]: where one chunk samples, with the overlap and padding contract.
 //!
 //! World positions are `f64`, planet-centred, in metres.
@@ -37,6 +38,6 @@ pub use cube_sphere::{
 pub use face::{Face, FaceAxis, FaceFrame};
 pub use face_conversion::{convert_axis, AxisMap, FaceTransition};
 pub use glam;
-pub use keys::{ChunkKey, ChunkSide, EdgeKey, SideMask, VoxelKey};
+pub use keys::{ChunkKey, ChunkKeyParseError, ChunkSide, EdgeKey, SideMask, VoxelKey};
 pub use latlon::{LatLon, LatLonError, Place, PlaceParseError};
 pub use layout::{face_lattice, FaceGrid, Layout, LayoutError, MAX_AXIS_TILES, MAX_CHUNK_TILES};

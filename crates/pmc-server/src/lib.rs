@@ -36,6 +36,7 @@ mod lru;
 pub mod nav_api;
 mod planets;
 mod rate;
+mod request;
 mod server;
 mod state;
 

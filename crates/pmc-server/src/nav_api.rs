@@ -2,7 +2,7 @@
 //! between two places, `docs/specs/path-v1.md`) and `GET /api/v1/navgrid` (the grid's nodes and
 //! steps near a point, with their components, for drawing).
 
-use crate::api::{ApiError, Params};
+use crate::request::{ApiError, Params};
 use crate::AppState;
 use axum::extract::{RawQuery, State};
 use axum::http::{header, HeaderValue};
