@@ -8,6 +8,7 @@
 //! - [`ChunkKey`] (text form `face/level/i/j/k`), [`VoxelKey`], [`EdgeKey`]: chunk identity and
 //!   canonical voxel identity.
 //! - [`ChunkGrid`]: where one chunk samples, with the overlap and padding contract.
+//! - [`math`]: `lerp`, `smoothstep` and `srgb_to_linear`, one definition each for every crate.
 //!
 //! World positions are `f64`, planet-centred, in metres.
 //!
@@ -30,6 +31,7 @@ mod face_conversion;
 mod keys;
 mod latlon;
 mod layout;
+pub mod math;
 
 pub use chunk_grid::ChunkGrid;
 pub use cube_sphere::{
