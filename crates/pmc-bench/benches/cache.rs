@@ -17,7 +17,7 @@ use std::sync::Arc;
 mod base_cache;
 
 #[allow(dead_code, unused_imports)]
-#[path = "../../pmc-server/src/lru.rs"]
+#[path = "../../pmc-server/src/chunk_cache.rs"]
 mod chunk_cache;
 
 /// Entries a cache holds.
@@ -70,7 +70,7 @@ fn cache(c: &mut Criterion) {
     });
 
     let bytes: Arc<[u8]> = Arc::from(vec![0u8; 16]);
-    let mut chunks = chunk_cache::ByteLru::new(u64::from(HELD) * CHUNK_BYTES);
+    let mut chunks = chunk_cache::ByteCache::new(u64::from(HELD) * CHUNK_BYTES);
     for n in 0..HELD {
         chunks.insert(key(n), bytes.clone(), CHUNK_BYTES);
     }
