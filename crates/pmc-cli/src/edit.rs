@@ -6,7 +6,7 @@ use crate::planet_args::PlanetArgs;
 use clap::{Args, Parser, ValueEnum};
 use pmc_edit::{BrushKind, BrushOp};
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{LatLon, Layout};
+use pmc_geometry::{LatLon, Layout, Place};
 use pmc_planet::{Interpolation, Planet, PresetKind, TerrainSpec};
 use pmc_world::{Entry, World};
 use std::io::Write;
@@ -236,63 +236,30 @@ impl WorldPlanetArgs {
     }
 }
 
-/// A place: `LAT,LON[,ALT]` (degrees, and metres above the datum).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct At {
-    pub(crate) lat: f64,
-    pub(crate) lon: f64,
-    pub(crate) alt: Option<f64>,
-}
-
-fn parse_at(s: &str) -> Result<At, CliError> {
+fn parse_at(s: &str) -> Result<Place, CliError> {
     parse_place("--at", s)
 }
 
 /// Parses the value `s` of option `opt` as `LAT,LON[,ALT]`.
-pub(crate) fn parse_place(opt: &str, s: &str) -> Result<At, CliError> {
-    let err = |why: String| {
-        CliError::Edit(format!(
-            "{opt} {s}: {why}; give LAT,LON or LAT,LON,ALT (degrees, metres)"
-        ))
-    };
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if !(2..=3).contains(&parts.len()) {
-        return Err(err(format!("expected 2 or 3 numbers, got {}", parts.len())));
-    }
-    let num = |name: &str, t: &str| {
-        t.parse::<f64>()
-            .map_err(|_| err(format!("the {name} {t:?} is not a number")))
-    };
-    let lat = num("latitude", parts[0])?;
-    let lon = num("longitude", parts[1])?;
-    LatLon::new(lat, lon).map_err(|e| err(e.to_string()))?;
-    let alt = match parts.get(2) {
-        Some(t) => {
-            let a = num("altitude", t)?;
-            if !a.is_finite() {
-                return Err(err(format!("the altitude {a} is not a finite number of metres")));
-            }
-            Some(a)
-        }
-        None => None,
-    };
-    Ok(At { lat, lon, alt })
+pub(crate) fn parse_place(opt: &str, s: &str) -> Result<Place, CliError> {
+    s.parse::<Place>()
+        .map_err(|e| CliError::Edit(format!("{opt} {s}: {e}; give LAT,LON or LAT,LON,ALT (degrees, metres)")))
 }
 
 /// The centre of edit `k` of a `--repeat` run.
-fn center(planet: &Planet, at: At, k: u64) -> Result<DVec3, CliError> {
-    let lon = at.lon + k as f64 * REPEAT_LON_STEP;
-    let dir = LatLon::new(at.lat, lon)
+fn center(planet: &Planet, at: Place, k: u64) -> Result<DVec3, CliError> {
+    let lon = at.lon() + k as f64 * REPEAT_LON_STEP;
+    let dir = LatLon::new(at.lat(), lon)
         .map_err(|e| CliError::Edit(format!("--at: {e}")))?
         .to_unit();
-    let r = match at.alt {
+    let r = match at.alt() {
         Some(alt) => planet.datum_radius() + alt,
         None => planet.surface_radius(dir),
     };
     if r <= 0.0 {
         return Err(CliError::Edit(format!(
             "--at: altitude {} m puts the centre at or below the planet's centre (the datum is {} m from it)",
-            at.alt.unwrap_or(0.0),
+            at.alt().unwrap_or(0.0),
             planet.datum_radius()
         )));
     }
@@ -579,9 +546,9 @@ mod tests {
     #[test]
     fn at_is_parsed_and_checked() {
         let a = parse_at("10,-20.5").unwrap();
-        assert_eq!((a.lat, a.lon, a.alt), (10.0, -20.5, None));
+        assert_eq!((a.lat(), a.lon(), a.alt()), (10.0, -20.5, None));
         let a = parse_at("-10, 20, -3.5").unwrap();
-        assert_eq!((a.lat, a.lon, a.alt), (-10.0, 20.0, Some(-3.5)));
+        assert_eq!((a.lat(), a.lon(), a.alt()), (-10.0, 20.0, Some(-3.5)));
         for bad in ["91,0", "NaN,0", "0,inf", "0,0,NaN", "0", "1,2,3,4", "a,b", "0,0,inf"] {
             assert!(parse_at(bad).is_err(), "{bad}");
         }

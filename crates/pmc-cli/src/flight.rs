@@ -44,7 +44,7 @@ pub struct FlightArgs {
 /// Parses `LAT,LON`.
 fn parse_at(s: &str) -> Result<(f64, f64), CliError> {
     let place = crate::edit::parse_place("--at", s)?;
-    Ok((place.lat, place.lon))
+    Ok((place.lat(), place.lon()))
 }
 
 /// Runs `pmc bench-flight`.

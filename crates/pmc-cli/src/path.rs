@@ -5,11 +5,11 @@
 //! path a shortest one); larger ones, the Earth at true scale among them, get the lazy grid, built
 //! tile by tile around the search within its bounds (`--max-expanded`, `--max-tiles`, `--weight`).
 
-use crate::edit::{parse_place, At};
+use crate::edit::parse_place;
 use crate::error::CliError;
 use crate::planet_args::PlanetArgs;
 use clap::{Args, ValueEnum};
-use pmc_geometry::LatLon;
+use pmc_geometry::{LatLon, Place};
 use pmc_nav::{
     lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, wants_lazy_grid, Agent, End, LazyGrid,
     LazyOptions, NavGrid, PathAnswer, SearchOptions,
@@ -106,15 +106,15 @@ pub struct PathArgs {
 }
 
 /// One end: direction, and the radius of the floor when an altitude is given.
-fn end(at: At, datum: f64) -> End {
+fn end(at: Place, datum: f64) -> End {
     let dir = LatLon {
-        lat: at.lat,
-        lon: at.lon,
+        lat: at.lat(),
+        lon: at.lon(),
     }
     .to_unit();
     End {
         dir,
-        radius: at.alt.map(|a| datum + a),
+        radius: at.alt().map(|a| datum + a),
     }
 }
 

@@ -53,15 +53,7 @@ pub struct RenderArgs {
 }
 
 fn parse_lat_lon(s: &str) -> Result<LatLon, String> {
-    let (a, b) = s
-        .split_once(',')
-        .ok_or_else(|| format!("expected LAT,LON in degrees, got '{s}'"))?;
-    let num = |x: &str| {
-        x.trim()
-            .parse::<f64>()
-            .map_err(|_| format!("'{}' is not a number of degrees", x.trim()))
-    };
-    LatLon::new(num(a)?, num(b)?).map_err(|e| e.to_string())
+    s.parse::<LatLon>().map_err(|e| format!("{e}; give LAT,LON in degrees"))
 }
 
 /// Runs `pmc render`.

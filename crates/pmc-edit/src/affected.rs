@@ -421,10 +421,11 @@ mod tests {
         }
     }
 
-    /// A paint ball between the samples (here one on a face edge, where the failure was first
-    /// seen) still lists the chunks whose vertices it colours.
+    /// A paint ball small enough to fall between the samples (here one on a face edge) changes
+    /// no sample but the vertices on the grid edges through it; its chunks were missed when the
+    /// reach was not widened by one grid edge.
     #[test]
-    fn a_paint_ball_between_samples_lists_its_chunks() {
+    fn paint_ball_between_samples_missed_the_chunks_it_colours() {
         let layout = Layout::new(2, 8, 60.0, 1.0, 2).unwrap();
         let c = DVec3::new(51.773563991030706, 45.589669844307366, 0.0);
         let op = BrushOp::new(BrushKind::Paint { material: 2 }, c, 2.9298586043343344, 0.2).unwrap();

@@ -14,7 +14,7 @@ pub(crate) struct Checked<'a> {
     pub attributes: bool,
 }
 
-/// The display name of a chunk: its key (`top/L0/3_4_1`), or `chunk-N` without one.
+/// The display name of a chunk: its key (`top/0/3/4/1`), or `chunk-N` without one.
 pub(crate) fn chunk_name(index: usize, mesh: &ChunkMesh) -> String {
     match &mesh.key {
         Some(k) => k.to_string(),
@@ -174,6 +174,6 @@ mod tests {
         let mut m = tri();
         assert_eq!(chunk_name(7, &m), "chunk-7");
         m.key = Some(pmc_geometry::ChunkKey::new(pmc_geometry::Face::Top, 3, 4, 1));
-        assert_eq!(chunk_name(7, &m), "top/L0/3_4_1");
+        assert_eq!(chunk_name(7, &m), "top/0/3/4/1");
     }
 }

@@ -5,7 +5,7 @@
 //! with `gltf-json`; the binary container (header, JSON chunk, BIN chunk) is written here, and the
 //! vertex data is streamed straight from the chunk meshes without an intermediate copy.
 
-use crate::check::{check_meshes, chunk_name, Checked};
+use crate::check::{check_meshes, Checked};
 use crate::export::Counting;
 use crate::sea::{sea_faces, SeaFace, SEA_QUADS};
 use crate::{ExportError, ExportMeta, ExportStats};
@@ -29,6 +29,17 @@ const VERSION: u32 = 2;
 const CHUNK_JSON: u32 = 0x4E4F_534A;
 /// Chunk type of the binary chunk (`BIN\0`).
 const CHUNK_BIN: u32 = 0x004E_4942;
+
+/// A chunk's node and mesh name, fixed by version 1 of the layout (`docs/specs/glb-v1.md`):
+/// `face/L<level>/<i>_<j>_<k>` (for example `top/L0/3_4_1`), or `chunk-N` for a mesh without a
+/// key. Files keep these names so that readers of version 1 find their nodes; everywhere else a
+/// key is written in its own text form, `face/level/i/j/k` (`ChunkKey`'s `Display`).
+fn node_name(index: usize, mesh: &ChunkMesh) -> String {
+    match &mesh.key {
+        Some(k) => format!("{}/L{}/{}_{}_{}", k.face, k.level, k.i, k.j, k.k),
+        None => format!("chunk-{index}"),
+    }
+}
 
 /// Writes `meshes` as one binary glTF 2.0 file (layout: `docs/specs/glb-v1.md`).
 ///
@@ -285,7 +296,7 @@ pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -
         let terrain = b.root.push(material("terrain", [1.0; 4], 0.9, false));
         for c in &checked {
             let m = c.mesh;
-            let name = chunk_name(c.index, m);
+            let name = node_name(c.index, m);
             let mut attrs = BTreeMap::new();
             attrs.insert(
                 Valid(Semantic::Positions),

@@ -1,11 +1,9 @@
 //! Wavefront OBJ export, layout version 1 (`docs/specs/obj-v1.md`): one welded world-space mesh.
 
-use crate::check::check_meshes;
-use crate::export::Counting;
-use crate::weld::weld;
+use crate::weld::WeldedExport;
 use crate::{ExportError, ExportMeta, ExportStats};
 use pmc_mesh::ChunkMesh;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 
 /// Writes `meshes` as one welded world-space OBJ mesh (layout: `docs/specs/obj-v1.md`).
 ///
@@ -18,10 +16,8 @@ pub fn write_obj<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -> R
 
 /// Writes the OBJ and returns what it wrote.
 pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -> Result<ExportStats, ExportError> {
-    meta.check()?;
-    let checked = check_meshes(meshes)?;
-    let welded = weld(&checked)?;
-    let mut out = BufWriter::with_capacity(1 << 16, Counting::new(out));
+    let mut export = WeldedExport::begin(meshes, meta, out)?;
+    let (checked, welded, out) = (&export.checked, &export.welded, &mut export.out);
     for line in meta.comment_lines("pmc-obj") {
         writeln!(out, "# {line}")?;
     }
@@ -41,12 +37,5 @@ pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -
         let (a, b, c) = (t[0] as u64 + 1, t[1] as u64 + 1, t[2] as u64 + 1);
         writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
     }
-    out.flush()?;
-    let bytes = out.get_ref().bytes();
-    Ok(ExportStats {
-        bytes,
-        vertices: welded.sources.len() as u64,
-        triangles: welded.triangle_count() as u64,
-        meshes: checked.len(),
-    })
+    export.finish()
 }

@@ -1,12 +1,10 @@
 //! Binary PLY export, layout version 1 (`docs/specs/ply-v1.md`): one welded world-space mesh with
 //! `f64` positions and the per-vertex attributes.
 
-use crate::check::check_meshes;
-use crate::export::Counting;
-use crate::weld::weld;
+use crate::weld::WeldedExport;
 use crate::{ExportError, ExportMeta, ExportStats};
 use pmc_mesh::ChunkMesh;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 
 /// Bytes of one vertex record: 3 doubles, 3 floats, 4 uchars, 2 floats, 1 uchar.
 pub const PLY_VERTEX_BYTES: u64 = 3 * 8 + 3 * 4 + 4 + 2 * 4 + 1;
@@ -29,10 +27,8 @@ pub fn write_ply<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -> R
 
 /// Writes the PLY and returns what it wrote.
 pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -> Result<ExportStats, ExportError> {
-    meta.check()?;
-    let checked = check_meshes(meshes)?;
-    let welded = weld(&checked)?;
-    let mut out = BufWriter::with_capacity(1 << 16, Counting::new(out));
+    let mut export = WeldedExport::begin(meshes, meta, out)?;
+    let (checked, welded, out) = (&export.checked, &export.welded, &mut export.out);
     let mut header = String::from("ply\nformat binary_little_endian 1.0\n");
     for line in meta.comment_lines("pmc-ply") {
         header.push_str(&format!("comment {line}\n"));
@@ -88,12 +84,5 @@ pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -
         }
         out.write_all(&rec)?;
     }
-    out.flush()?;
-    let bytes = out.get_ref().bytes();
-    Ok(ExportStats {
-        bytes,
-        vertices: welded.sources.len() as u64,
-        triangles: welded.triangle_count() as u64,
-        meshes: checked.len(),
-    })
+    export.finish()
 }

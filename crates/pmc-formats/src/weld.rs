@@ -6,10 +6,50 @@
 //! kept, numbered in order of first use; a welded vertex takes its position, normal and attributes
 //! from that first use. Triangles that collapse (two corners the same vertex) are dropped.
 
-use crate::check::Checked;
-use crate::ExportError;
+use crate::check::{check_meshes, Checked};
+use crate::export::Counting;
+use crate::{ExportError, ExportMeta, ExportStats};
 use pmc_geometry::EdgeKey;
+use pmc_mesh::ChunkMesh;
 use std::collections::HashMap;
+use std::io::{BufWriter, Write};
+
+/// The part the welded exports (OBJ, PLY) share: the metadata and every mesh checked, the meshes
+/// welded, and a buffered writer that counts its bytes. A writer begins one, writes its header
+/// and body into `out`, then calls [`WeldedExport::finish`].
+pub(crate) struct WeldedExport<'a, W: Write> {
+    /// The meshes with triangles, checked, in input order.
+    pub checked: Vec<Checked<'a>>,
+    /// Their welded mesh.
+    pub welded: Welded,
+    /// Where the file goes.
+    pub out: BufWriter<Counting<W>>,
+}
+
+impl<'a, W: Write> WeldedExport<'a, W> {
+    /// Checks `meta` and `meshes` and welds the meshes, before anything is written to `out`.
+    pub(crate) fn begin(meshes: &'a [ChunkMesh], meta: &ExportMeta, out: W) -> Result<Self, ExportError> {
+        meta.check()?;
+        let checked = check_meshes(meshes)?;
+        let welded = weld(&checked)?;
+        Ok(WeldedExport {
+            checked,
+            welded,
+            out: BufWriter::with_capacity(1 << 16, Counting::new(out)),
+        })
+    }
+
+    /// Flushes the file and says what was written.
+    pub(crate) fn finish(mut self) -> Result<ExportStats, ExportError> {
+        self.out.flush()?;
+        Ok(ExportStats {
+            bytes: self.out.get_ref().bytes(),
+            vertices: self.welded.sources.len() as u64,
+            triangles: self.welded.triangle_count() as u64,
+            meshes: self.checked.len(),
+        })
+    }
+}
 
 /// One welded mesh, as references into the source meshes.
 #[derive(Debug, Default)]

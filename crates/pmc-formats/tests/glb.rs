@@ -146,7 +146,10 @@ fn chunks_round_trip_exactly() {
         .collect();
     assert_eq!(children.len(), 3);
     for (i, m) in meshes.iter().enumerate() {
-        let name = m.key.map_or(format!("chunk-{i}"), |k| k.to_string());
+        // Node names as glb-v1.md fixes them: `face/L<level>/<i>_<j>_<k>`.
+        let name = m.key.map_or(format!("chunk-{i}"), |k| {
+            format!("{}/L{}/{}_{}_{}", k.face, k.level, k.i, k.j, k.k)
+        });
         let n = g.node(&name);
         assert_eq!(children[i], n, "chunk nodes are the planet's children in input order");
         // f64 origin survives bit for bit in the JSON.

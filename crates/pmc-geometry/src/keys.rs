@@ -151,9 +151,62 @@ impl SideMask {
     }
 }
 
+/// The text form of a chunk key, the one every program and file uses (the HTTP API's chunk
+/// paths, edit events, GLB node names): `face/level/i/j/k`, for example `top/0/3/4/1`.
 impl std::fmt::Display for ChunkKey {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/L{}/{}_{}_{}", self.face, self.level, self.i, self.j, self.k)
+        write!(f, "{}/{}/{}/{}/{}", self.face, self.level, self.i, self.j, self.k)
+    }
+}
+
+/// Why a text was refused as a chunk key (`face/level/i/j/k`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ChunkKeyParseError {
+    /// Not five `/`-separated parts. Write `face/level/i/j/k`, for example `top/0/3/4/1`.
+    #[error("expected face/level/i/j/k (for example top/0/3/4/1), got {0} parts")]
+    Parts(usize),
+    /// The first part is not a face name. Use top, bottom, north, south, east or west.
+    #[error("{0}")]
+    Face(String),
+    /// A numeric part is not a non-negative decimal integer in range (level below 256, indices
+    /// below 2^32).
+    #[error("chunk {what} must be a non-negative integer, got {text:?}")]
+    Index {
+        /// `level`, `i`, `j` or `k`.
+        what: &'static str,
+        /// The part as written.
+        text: String,
+    },
+}
+
+impl std::str::FromStr for ChunkKey {
+    type Err = ChunkKeyParseError;
+
+    /// Parses `face/level/i/j/k` (the face name in any case). Whether the key is a chunk of a
+    /// given layout is not checked: see [`Layout::contains_chunk`](crate::Layout::contains_chunk).
+    fn from_str(s: &str) -> Result<ChunkKey, ChunkKeyParseError> {
+        let parts: Vec<&str> = s.split('/').collect();
+        let [face, level, i, j, k] = parts[..] else {
+            return Err(ChunkKeyParseError::Parts(parts.len()));
+        };
+        let face: Face = face.parse().map_err(ChunkKeyParseError::Face)?;
+        let index = |what: &'static str, text: &str| {
+            text.parse::<u32>().map_err(|_| ChunkKeyParseError::Index {
+                what,
+                text: text.to_string(),
+            })
+        };
+        let level = u8::try_from(index("level", level)?).map_err(|_| ChunkKeyParseError::Index {
+            what: "level",
+            text: level.to_string(),
+        })?;
+        Ok(ChunkKey {
+            face,
+            level,
+            i: index("i", i)?,
+            j: index("j", j)?,
+            k: index("k", k)?,
+        })
     }
 }
 
@@ -200,5 +253,52 @@ impl EdgeKey {
         } else {
             EdgeKey(pb, pa)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunk_keys_round_trip_through_text() {
+        let key = ChunkKey {
+            face: Face::Top,
+            level: 0,
+            i: 3,
+            j: 4,
+            k: 1,
+        };
+        assert_eq!(key.to_string(), "top/0/3/4/1");
+        for face in Face::ALL {
+            let key = ChunkKey {
+                face,
+                level: 255,
+                i: u32::MAX,
+                j: 0,
+                k: 7,
+            };
+            assert_eq!(key.to_string().parse::<ChunkKey>(), Ok(key));
+        }
+        assert_eq!("West/2/0/1/0".parse::<ChunkKey>().unwrap().face, Face::West);
+    }
+
+    #[test]
+    fn bad_chunk_keys_are_refused_with_the_reason() {
+        let err = |s: &str| s.parse::<ChunkKey>().unwrap_err();
+        assert_eq!(err("top/0/3/4"), ChunkKeyParseError::Parts(4));
+        assert_eq!(err(""), ChunkKeyParseError::Parts(1));
+        assert_eq!(err("top/0/3/4/1/"), ChunkKeyParseError::Parts(6));
+        assert!(matches!(err("up/0/0/0/0"), ChunkKeyParseError::Face(m) if m.contains("unknown face 'up'")));
+        let index = |what: &'static str, text: &str| ChunkKeyParseError::Index {
+            what,
+            text: text.into(),
+        };
+        assert_eq!(err("top/L0/3/4/1"), index("level", "L0"));
+        assert_eq!(err("top/256/0/0/0"), index("level", "256"));
+        assert_eq!(err("top/0/-1/0/0"), index("i", "-1"));
+        assert_eq!(err("top/0/0/4294967296/0"), index("j", "4294967296"));
+        assert_eq!(err("top/0/0/0/x"), index("k", "x"));
+        assert_eq!(err("top/0/3_4_1"), ChunkKeyParseError::Parts(3));
     }
 }

@@ -3,10 +3,12 @@
 //! - [`cube_to_sphere`] and [`sphere_to_cube`]: Eq. (1) and its exact inverse.
 //! - [`Face`]: the six faces with their local frames (two face axes and the outward depth axis).
 //! - [`FaceTransition`]: Algorithm 1, positions and directions between adjacent faces.
-//! - [`LatLon`]: geographic coordinates.
+//! - [`LatLon`], [`Place`]: geographic coordinates, and their text forms `LAT,LON[,ALT]`.
 //! - [`Layout`]: the parameters `n_c, n_t, d_b, l_d, d_c` and Eq. (2)-(4).
-//! - [`ChunkKey`], [`VoxelKey`], [`EdgeKey`]: chunk identity and canonical voxel identity.
+//! - [`ChunkKey`] (text form `face/level/i/j/k`), [`VoxelKey`], [`EdgeKey`]: chunk identity and
+//!   canonical voxel identity.
 //! - [`ChunkGrid`]: where one chunk samples, with the overlap and padding contract.
+//! - [`math`]: `lerp`, `smoothstep` and `srgb_to_linear`, one definition each for every crate.
 //!
 //! World positions are `f64`, planet-centred, in metres.
 //!
@@ -29,6 +31,7 @@ mod face_conversion;
 mod keys;
 mod latlon;
 mod layout;
+pub mod math;
 
 pub use chunk_grid::ChunkGrid;
 pub use cube_sphere::{
@@ -37,6 +40,6 @@ pub use cube_sphere::{
 pub use face::{Face, FaceAxis, FaceFrame};
 pub use face_conversion::{convert_axis, AxisMap, FaceTransition};
 pub use glam;
-pub use keys::{ChunkKey, ChunkSide, EdgeKey, SideMask, VoxelKey};
-pub use latlon::{LatLon, LatLonError};
+pub use keys::{ChunkKey, ChunkKeyParseError, ChunkSide, EdgeKey, SideMask, VoxelKey};
+pub use latlon::{LatLon, LatLonError, Place, PlaceParseError};
 pub use layout::{face_lattice, FaceGrid, Layout, LayoutError, MAX_AXIS_TILES, MAX_CHUNK_TILES};

@@ -1,11 +1,11 @@
-//! A bounded, shared LRU cache of the terrain's base density batches, by chunk.
+//! A bounded cache of the terrain's base density batches, by chunk, shared by a planet's clones.
 //!
 //! The base terrain never changes (edits apply on top of it), so a chunk's base batch stays valid
 //! for the planet's whole life, across every edit, undo and redo. Meshing a chunk again after an
 //! edit then pays only for the edits over a copy of the cached batch, not for the terrain noise.
 
 use pmc_geometry::ChunkKey;
-use std::collections::{BTreeMap, HashMap};
+use quick_cache::unsync::Cache;
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// How a planet's base density cache is doing: see [`crate::Planet::base_cache_stats`].
@@ -23,21 +23,17 @@ pub struct BaseCacheStats {
     pub misses: u64,
 }
 
-/// The cache: least recently used batches go first once `max_chunks` are held.
+/// The cache: at most `max_chunks` batches (`quick_cache`, one unit of weight a batch); when
+/// full, batches used again are kept over batches used once.
 #[derive(Debug)]
 pub(crate) struct BaseCache {
     max_chunks: usize,
-    inner: Mutex<Lru>,
+    inner: Mutex<Inner>,
 }
 
-#[derive(Debug, Default)]
-struct Lru {
-    /// Each batch and the tick of its last use.
-    map: HashMap<ChunkKey, (Arc<[f32]>, u64)>,
-    /// Keys by the tick of their last use: the first is the least recently used.
-    order: BTreeMap<u64, ChunkKey>,
-    tick: u64,
-    bytes: usize,
+#[derive(Debug)]
+struct Inner {
+    batches: Cache<ChunkKey, Arc<[f32]>>,
     hits: u64,
     misses: u64,
 }
@@ -48,66 +44,47 @@ impl BaseCache {
         debug_assert!(max_chunks > 0);
         BaseCache {
             max_chunks,
-            inner: Mutex::new(Lru::default()),
+            inner: Mutex::new(Inner {
+                batches: Cache::new(max_chunks),
+                hits: 0,
+                misses: 0,
+            }),
         }
     }
 
-    /// The lock; a panic while it was held cannot leave the maps inconsistent (every update
-    /// completes before anything that could panic), so a poisoned lock is taken as is.
-    fn lock(&self) -> MutexGuard<'_, Lru> {
+    /// The lock; a panic while it was held cannot leave the cache inconsistent (its updates do
+    /// not call back into code that could panic), so a poisoned lock is taken as is.
+    fn lock(&self) -> MutexGuard<'_, Inner> {
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// The batch of `key`, if held, marked as just used. The caller copies it outside the lock.
+    /// The batch of `key`, if held, marked as used. The caller copies it outside the lock.
     pub(crate) fn get(&self, key: &ChunkKey) -> Option<Arc<[f32]>> {
-        let mut lru = self.lock();
-        lru.tick += 1;
-        let tick = lru.tick;
-        let Some((batch, used)) = lru.map.get_mut(key) else {
-            lru.misses += 1;
-            return None;
-        };
-        let (batch, old) = (batch.clone(), std::mem::replace(used, tick));
-        lru.order.remove(&old);
-        lru.order.insert(tick, *key);
-        lru.hits += 1;
-        Some(batch)
+        let mut inner = self.lock();
+        let found = inner.batches.get(key).cloned();
+        match found {
+            Some(_) => inner.hits += 1,
+            None => inner.misses += 1,
+        }
+        found
     }
 
-    /// Stores the batch of `key` (built by the caller outside the lock), dropping the least
-    /// recently used batches beyond `max_chunks`.
+    /// Stores the batch of `key` (built by the caller outside the lock), dropping others beyond
+    /// `max_chunks`. Another thread may have stored the same batch meanwhile (same bits: the
+    /// base is a pure function of the key); it is replaced.
     pub(crate) fn insert(&self, key: ChunkKey, batch: Arc<[f32]>) {
-        let mut lru = self.lock();
-        lru.tick += 1;
-        let tick = lru.tick;
-        let bytes = std::mem::size_of_val(&*batch);
-        if let Some((_, old)) = lru.map.insert(key, (batch, tick)) {
-            // Another thread stored the same batch meanwhile (same bits: the base is a pure
-            // function of the key).
-            lru.order.remove(&old);
-            lru.bytes -= bytes;
-        }
-        lru.order.insert(tick, key);
-        lru.bytes += bytes;
-        while lru.map.len() > self.max_chunks {
-            let Some((_, victim)) = lru.order.pop_first() else {
-                break;
-            };
-            if let Some((gone, _)) = lru.map.remove(&victim) {
-                lru.bytes -= std::mem::size_of_val(&*gone);
-            }
-        }
+        self.lock().batches.insert(key, batch);
     }
 
     /// Counts and sizes.
     pub(crate) fn stats(&self) -> BaseCacheStats {
-        let lru = self.lock();
+        let inner = self.lock();
         BaseCacheStats {
-            chunks: lru.map.len(),
+            chunks: inner.batches.len(),
             max_chunks: self.max_chunks,
-            bytes: lru.bytes,
-            hits: lru.hits,
-            misses: lru.misses,
+            bytes: inner.batches.iter().map(|(_, b)| std::mem::size_of_val(&**b)).sum(),
+            hits: inner.hits,
+            misses: inner.misses,
         }
     }
 }
@@ -126,26 +103,30 @@ mod tests {
     }
 
     #[test]
-    fn keeps_the_most_recently_used_within_its_bound() {
+    fn keeps_at_most_max_chunks_and_counts_lookups() {
         let c = BaseCache::new(2);
         c.insert(key(0), batch(0.0));
         c.insert(key(1), batch(1.0));
         assert_eq!(c.get(&key(0)).as_deref(), Some(&[0.0f32; 4][..]));
-        // Key 1 is now the least recently used: it goes.
         c.insert(key(2), batch(2.0));
-        assert!(c.get(&key(1)).is_none());
-        assert!(c.get(&key(0)).is_some() && c.get(&key(2)).is_some());
-        // Storing a held key again replaces it without growing.
-        c.insert(key(2), batch(2.0));
+        assert_eq!(
+            c.get(&key(2)).as_deref(),
+            Some(&[2.0f32; 4][..]),
+            "the batch just stored"
+        );
         let s = c.stats();
         assert_eq!((s.chunks, s.max_chunks, s.bytes), (2, 2, 2 * 16));
-        assert_eq!((s.hits, s.misses), (3, 1));
+        // Storing a held key again replaces it without growing.
+        c.insert(key(2), batch(2.0));
+        assert_eq!(c.stats(), s);
+        assert!(c.get(&key(7)).is_none());
+        let s = c.stats();
+        assert_eq!((s.hits, s.misses), (2, 1));
         for i in 3..50 {
             c.insert(key(i), batch(i as f32));
+            assert!(c.get(&key(i)).is_some(), "the batch just stored is held");
             let s = c.stats();
             assert!(s.chunks <= 2 && s.bytes == s.chunks * 16, "{s:?}");
-            let lru = c.lock();
-            assert_eq!(lru.map.len(), lru.order.len());
         }
     }
 }

@@ -182,7 +182,8 @@ impl Planet {
     }
 
     /// This planet with a cache of the terrain's base density batches for up to `max_chunks`
-    /// chunks (least recently used first out); `0` turns caching off (the default).
+    /// chunks (when full, batches used again are kept over batches used once); `0` turns caching
+    /// off (the default).
     ///
     /// Meshing a chunk samples the terrain's density over the chunk's whole padded grid, and on
     /// the presets that noise is most of a chunk's time. The terrain never changes (edits apply on

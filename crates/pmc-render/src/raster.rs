@@ -13,6 +13,7 @@
 //!    2x2 samples of each pixel are averaged in linear light and written as sRGB.
 
 use pmc_geometry::glam::DVec3;
+use pmc_geometry::math::{smoothstep, srgb_to_linear};
 use pmc_mesh::ChunkMesh;
 use rayon::prelude::*;
 
@@ -600,21 +601,6 @@ fn sphere_hits(o: DVec3, d: DVec3, r: f64) -> Option<(f64, f64)> {
     }
     let s = disc.sqrt();
     Some((-b - s, -b + s))
-}
-
-fn smoothstep(lo: f64, hi: f64, x: f64) -> f64 {
-    let t = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
-/// sRGB byte to linear light.
-pub(crate) fn srgb_to_linear(c: u8) -> f64 {
-    let s = f64::from(c) / 255.0;
-    if s <= 0.04045 {
-        s / 12.92
-    } else {
-        ((s + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// Linear light (clamped to [0, 1]) to an sRGB byte.

@@ -1,9 +1,9 @@
 //! The editing endpoints of `docs/specs/http-api-v1.md`: `POST /api/v1/edits`, `/edits/undo`,
 //! `/edits/redo`, `GET /api/v1/edits` and the server push `GET /api/v1/events`.
 
-use crate::api::{ApiError, Params};
 use crate::editing::{Action, EditEvent, Editing};
 use crate::generator::PlanetId;
+use crate::request::{ApiError, Params};
 use crate::AppState;
 use axum::extract::{ConnectInfo, RawQuery, Request, State};
 use axum::http::{header, HeaderValue, StatusCode};

@@ -54,8 +54,9 @@ pub(crate) struct Outcome {
     pub active: usize,
     /// Undone edits kept for redo after the action.
     pub redo: usize,
-    /// The level-0 chunks whose meshes the action can change, as API paths.
-    pub chunks: Vec<String>,
+    /// The chunks whose meshes the action can change (written as `face/level/i/j/k`).
+    #[serde(serialize_with = "keys_as_text")]
+    pub chunks: Vec<ChunkKey>,
 }
 
 /// A change pushed to subscribers of `/api/v1/events`.
@@ -72,8 +73,14 @@ pub(crate) struct EditEvent {
     /// The edit (absent for `resync`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub id: Option<u64>,
-    /// The chunks to reload (empty for `resync`: all of them).
-    pub chunks: Vec<String>,
+    /// The chunks to reload (empty for `resync`: all of them), written as `face/level/i/j/k`.
+    #[serde(serialize_with = "keys_as_text")]
+    pub chunks: Vec<ChunkKey>,
+}
+
+/// Writes chunk keys in their text form (`face/level/i/j/k`, as the chunk paths of the API).
+fn keys_as_text<S: serde::Serializer>(keys: &[ChunkKey], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(keys.iter().map(|k| k.to_string()))
 }
 
 /// The edited planet and the counts clients see, replaced as one after each change.
@@ -248,20 +255,19 @@ impl Editing {
         let keys = affected_chunks_lod(self.base.layout(), &op);
         let current = self.publish(&ed, generator, Some(&keys));
         self.follow_with_nav(&current, Some(&op));
-        let chunks: Vec<String> = keys.iter().map(crate::api::key_path).collect();
         let _ = self.events.send(EditEvent {
             event: "edit",
             revision: current.revision,
             action: Some(action.name()),
             id: Some(id.0),
-            chunks: chunks.clone(),
+            chunks: keys.clone(),
         });
         Ok(Outcome {
             id: Some(id.0),
             revision: current.revision,
             active: current.active,
             redo: current.redo,
-            chunks,
+            chunks: keys,
         })
     }
 
@@ -395,7 +401,7 @@ impl Editing {
                 revision: current.revision,
                 action: Some(action),
                 id: Some(id.0),
-                chunks: keys.iter().map(crate::api::key_path).collect(),
+                chunks: keys,
             },
             _ => EditEvent {
                 event: "resync",

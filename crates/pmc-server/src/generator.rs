@@ -7,7 +7,7 @@
 //! still waits for a worker, the job leaves the queue at once and is never meshed. A job that a
 //! worker has started runs to the end and is cached.
 
-use crate::lru::ByteLru;
+use crate::chunk_cache::ByteCache;
 use axum::body::Bytes;
 use pmc_formats::chunk_encoding::encode_chunk;
 use pmc_geometry::{ChunkKey, SideMask};
@@ -120,7 +120,7 @@ struct Job {
 }
 
 struct Store {
-    cache: ByteLru<ChunkId, Bytes>,
+    cache: ByteCache<ChunkId, Bytes>,
     /// Jobs queued or running, by token.
     jobs: HashMap<u64, Job>,
     /// For each chunk, the token of the job new requests for it join. A job an edit invalidated
@@ -211,7 +211,7 @@ impl Generator {
             .map_err(|e| e.to_string())?;
         Ok(Generator {
             store: Mutex::new(Store {
-                cache: ByteLru::new(cache_bytes),
+                cache: ByteCache::new(cache_bytes),
                 jobs: HashMap::new(),
                 pending: HashMap::new(),
                 queue: BTreeMap::new(),

@@ -5,11 +5,12 @@
 //! built files, embedded in the binary.
 //!
 //! - Chunks are generated on demand on a worker pool (never on the async runtime), cached as
-//!   encoded bytes in an LRU bounded by [`ServerConfig::cache_bytes`], and concurrent requests
+//!   encoded bytes in a cache bounded by [`ServerConfig::cache_bytes`], and concurrent requests
 //!   for one chunk share one generation. More than [`ServerConfig::queue_limit`] waiting jobs
 //!   make new chunk requests answer 503 with `Retry-After: 1`.
-//! - Requests may name any preset and seed; the [`ServerConfig::max_planets`] most recently used
-//!   planets are kept, each with its cached chunks.
+//! - Requests may name any preset and seed; up to
+//!   [`ServerConfig::max_planets`] planets are kept (those asked for again before those asked
+//!   for once), each with its cached chunks.
 //! - `/chunks` finds the chunks near a point with a quadtree per face over provable bounding
 //!   spheres (see [`pmc_lod::bounds`]), so it stays fast on planets of any size.
 //! - Every malformed request gets a 4xx with a JSON `{"error": ...}`; no request can panic the
@@ -26,16 +27,17 @@
 
 pub mod api;
 pub mod assets;
+mod chunk_cache;
 mod config;
 pub mod edit_api;
 mod editing;
 mod error;
 pub mod flight;
 mod generator;
-mod lru;
 pub mod nav_api;
 mod planets;
 mod rate;
+mod request;
 mod server;
 mod state;
 

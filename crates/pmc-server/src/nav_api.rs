@@ -2,14 +2,14 @@
 //! between two places, `docs/specs/path-v1.md`) and `GET /api/v1/navgrid` (the grid's nodes and
 //! steps near a point, with their components, for drawing).
 
-use crate::api::{ApiError, Params};
+use crate::request::{ApiError, Params};
 use crate::AppState;
 use axum::extract::{RawQuery, State};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::LatLon;
+use pmc_geometry::Place;
 use pmc_nav::{
     lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, wants_lazy_grid, Agent, End, LazyGrid,
     LazyOptions, NodeId, SearchOptions,
@@ -53,28 +53,14 @@ fn end(params: &Params, name: &str, datum: f64) -> Result<End, ApiError> {
     let raw = params
         .get(name)
         .ok_or_else(|| ApiError::bad_request(format!("missing query parameter '{name}' (LAT,LON or LAT,LON,ALT)")))?;
-    let bad = |why: String| {
+    let place = raw.parse::<Place>().map_err(|e| {
         ApiError::bad_request(format!(
-            "{name}={raw}: {why}; give LAT,LON or LAT,LON,ALT (degrees, metres)"
+            "{name}={raw}: {e}; give LAT,LON or LAT,LON,ALT (degrees, metres)"
         ))
-    };
-    let parts: Vec<&str> = raw.split(',').map(str::trim).collect();
-    if !(2..=3).contains(&parts.len()) {
-        return Err(bad(format!("expected 2 or 3 numbers, got {}", parts.len())));
-    }
-    let num = |t: &str| match t.parse::<f64>() {
-        Ok(x) if x.is_finite() => Ok(x),
-        _ => Err(bad(format!("'{t}' is not a finite number"))),
-    };
-    let (lat, lon) = (num(parts[0])?, num(parts[1])?);
-    let ll = LatLon::new(lat, lon).map_err(|e| bad(e.to_string()))?;
-    let radius = match parts.get(2) {
-        Some(t) => Some(datum + num(t)?),
-        None => None,
-    };
+    })?;
     Ok(End {
-        dir: ll.to_unit(),
-        radius,
+        dir: place.lat_lon().to_unit(),
+        radius: place.alt().map(|alt| datum + alt),
     })
 }
 

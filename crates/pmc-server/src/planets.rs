@@ -3,41 +3,57 @@
 use crate::generator::PlanetId;
 use pmc_geometry::Layout;
 use pmc_planet::Planet;
-use std::collections::VecDeque;
+use quick_cache::unsync::Cache;
+use quick_cache::{DefaultHashBuilder, Lifecycle, UnitWeighter};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-/// At most `max` planets of one layout, most recently used last.
+/// Collects the ids of the planets the cache drops, so that their chunks can be dropped too.
+#[derive(Clone, Copy, Debug, Default)]
+struct CollectDropped;
+
+impl Lifecycle<PlanetId, Arc<Planet>> for CollectDropped {
+    type RequestState = Vec<PlanetId>;
+
+    fn on_evict(&self, dropped: &mut Vec<PlanetId>, id: PlanetId, _planet: Arc<Planet>) {
+        dropped.push(id);
+    }
+}
+
+type PlanetCache = Cache<PlanetId, Arc<Planet>, UnitWeighter, DefaultHashBuilder, CollectDropped>;
+
+/// At most `max` planets of one layout; when full, planets asked for again are kept over
+/// planets asked for once (`quick_cache`'s policy).
 pub(crate) struct Planets {
     layout: Layout,
-    max: usize,
     /// The only planet served, already built (a height-field planet, whose layout is its own).
     pinned: Option<(PlanetId, Planet)>,
-    list: Mutex<VecDeque<(PlanetId, Arc<Planet>)>>,
+    cache: Mutex<PlanetCache>,
 }
 
 impl Planets {
     /// An empty set of at most `max` planets.
     pub fn new(layout: Layout, max: usize, pinned: Option<(PlanetId, Planet)>) -> Planets {
+        let max = max.max(1);
         Planets {
             layout,
-            max: max.max(1),
             pinned,
-            list: Mutex::new(VecDeque::new()),
+            cache: Mutex::new(Cache::with(
+                max,
+                max as u64,
+                UnitWeighter,
+                DefaultHashBuilder::default(),
+                CollectDropped,
+            )),
         }
     }
 
-    fn list(&self) -> MutexGuard<'_, VecDeque<(PlanetId, Arc<Planet>)>> {
-        self.list.lock().unwrap_or_else(PoisonError::into_inner)
+    fn cache(&self) -> MutexGuard<'_, PlanetCache> {
+        self.cache.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
-    /// The planet `id`, marked as just used, if it is held.
+    /// The planet `id`, marked as used, if it is held.
     pub fn get(&self, id: PlanetId) -> Option<Arc<Planet>> {
-        let mut list = self.list();
-        let at = list.iter().position(|(p, _)| *p == id)?;
-        let entry = list.remove(at)?;
-        let planet = Arc::clone(&entry.1);
-        list.push_back(entry);
-        Some(planet)
+        self.cache().get(&id).cloned()
     }
 
     /// Builds planet `id` (the caller runs this off the async runtime).
@@ -58,27 +74,18 @@ impl Planets {
     /// Adds `planet` as `id` (keeping one already added by a concurrent request) and returns the
     /// planet to use and the planets dropped to make room.
     pub fn insert(&self, id: PlanetId, planet: Planet) -> (Arc<Planet>, Vec<PlanetId>) {
-        let mut list = self.list();
-        if let Some(at) = list.iter().position(|(p, _)| *p == id) {
-            if let Some(entry) = list.remove(at) {
-                let planet = Arc::clone(&entry.1);
-                list.push_back(entry);
-                return (planet, Vec::new());
-            }
+        let mut cache = self.cache();
+        if let Some(held) = cache.get(&id) {
+            return (Arc::clone(held), Vec::new());
         }
         let planet = Arc::new(planet);
-        list.push_back((id, Arc::clone(&planet)));
         let mut dropped = Vec::new();
-        while list.len() > self.max {
-            if let Some((old, _)) = list.pop_front() {
-                dropped.push(old);
-            }
-        }
+        cache.insert_with_lifecycle(id, Arc::clone(&planet), &mut dropped);
         (planet, dropped)
     }
 
     /// Number of planets held.
     pub fn len(&self) -> usize {
-        self.list().len()
+        self.cache().len()
     }
 }

@@ -296,8 +296,8 @@ impl AppState {
         &self,
         id: PlanetId,
         agent: Agent,
-    ) -> Result<(Arc<NavGrid>, Arc<Planet>, u64), crate::api::ApiError> {
-        use crate::api::ApiError;
+    ) -> Result<(Arc<NavGrid>, Arc<Planet>, u64), crate::request::ApiError> {
+        use crate::request::ApiError;
         let (planet, revision) = self.planet(id.clone()).await.map_err(ApiError::internal)?;
         let world = self
             .editing_of(id.clone())

@@ -13,7 +13,6 @@ use pmc_formats::chunk_encoding::encode_chunk;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Layout};
 use pmc_planet::{Planet, PresetKind};
-use pmc_server::api::key_path;
 use pmc_server::{router, AppState, EditLimits, ServerConfig};
 use pmc_world::World;
 use serde_json::{json, Value};
@@ -82,7 +81,7 @@ fn encoded_seams(planet: &Planet, key: ChunkKey) -> Vec<u8> {
 }
 
 fn chunk_uri(key: &ChunkKey) -> String {
-    format!("/api/v1/chunk/{}", key_path(key))
+    format!("/api/v1/chunk/{key}")
 }
 
 fn unedited() -> Planet {
@@ -183,7 +182,7 @@ async fn edits_change_exactly_the_listed_chunks_and_undo_redo_restore_them() {
         (v["id"].as_u64(), v["revision"].as_u64(), v["active"].as_u64()),
         (Some(1), Some(1), Some(1))
     );
-    let listed: Vec<String> = keys.iter().map(key_path).collect();
+    let listed: Vec<String> = keys.iter().map(ToString::to_string).collect();
     assert_eq!(v["chunks"], json!(listed));
 
     // After the answer, every chunk is the edited planet's: the listed ones changed, the cache
@@ -533,7 +532,7 @@ async fn subscribers_are_told_of_every_edit_in_order() {
     );
     let listed: Vec<String> = affected_chunks_lod(&small_layout(), &op2)
         .iter()
-        .map(key_path)
+        .map(ToString::to_string)
         .collect();
     assert_eq!(e["chunks"], json!(listed));
     assert!(!state.sync_world().await.unwrap(), "nothing new");

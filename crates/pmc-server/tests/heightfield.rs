@@ -63,11 +63,7 @@ async fn patches_are_served_as_chunks_of_the_patch_layout() {
         j: 2,
         k: 0,
     };
-    let r = get(
-        &a,
-        &format!("/api/v1/chunk/{}?seams=5", pmc_server::api::key_path(&key)),
-    )
-    .await;
+    let r = get(&a, &format!("/api/v1/chunk/{key}?seams=5")).await;
     assert_eq!(r.status, StatusCode::OK);
     let d = decode_chunk(&r.body).unwrap();
     let mesh = planet.chunk_mesh_lod(key, SideMask(5));

@@ -11,7 +11,6 @@ use pmc_formats::chunk_encoding::{decode_chunk, encode_chunk};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Face, Layout};
 use pmc_planet::{Planet, PresetKind};
-use pmc_server::api::key_path;
 use pmc_server::{Server, ServerConfig};
 use serde_json::Value;
 use std::io::Write;
@@ -47,7 +46,7 @@ fn surface_chunks() -> Vec<ChunkKey> {
 }
 
 fn chunk_uri(key: &ChunkKey) -> String {
-    format!("/api/v1/chunk/{}", key_path(key))
+    format!("/api/v1/chunk/{key}")
 }
 
 /// Requests `uri` on a task of its own.

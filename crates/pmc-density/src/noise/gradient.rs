@@ -23,6 +23,7 @@
 
 use super::hash::{corner_hash, LATTICE_X, LATTICE_Y, LATTICE_Z};
 use pmc_geometry::glam::DVec3;
+use pmc_geometry::math::lerp;
 
 /// The largest magnitude the unscaled noise can reach (see the module docs for the derivation).
 pub const GRADIENT_RAW_MAX: f64 = 1.036_353_811_211_803;
@@ -68,11 +69,6 @@ fn fade(t: f64) -> f64 {
 fn grad(h: u64, x: f64, y: f64, z: f64) -> f64 {
     let i = (h >> 60) as usize;
     GX[i] * x + GY[i] * y + GZ[i] * z
-}
-
-#[inline(always)]
-fn lerp(t: f64, a: f64, b: f64) -> f64 {
-    a + t * (b - a)
 }
 
 /// Gradient noise at `p` (lattice units) for `seed`: a value in `[-1, 1]`, zero at lattice points,
@@ -145,9 +141,9 @@ impl Cell {
         let n011 = grad(corner_hash(x0 ^ y1 ^ z1), fx, gy, gz);
         let n111 = grad(corner_hash(x1 ^ y1 ^ z1), gx, gy, gz);
         let [u, v, w] = self.w;
-        let a = lerp(v, lerp(u, n000, n100), lerp(u, n010, n110));
-        let b = lerp(v, lerp(u, n001, n101), lerp(u, n011, n111));
-        lerp(w, a, b) * SCALE
+        let a = lerp(lerp(n000, n100, u), lerp(n010, n110, u), v);
+        let b = lerp(lerp(n001, n101, u), lerp(n011, n111, u), v);
+        lerp(a, b, w) * SCALE
     }
 }
 

@@ -18,19 +18,7 @@ use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
 
-/// `smoothstep` from `e0` to `e1` (either order): 0 before `e0`, 1 after `e1`, C1 in between.
-/// Exactly 0 and exactly 1 outside the ramp, which the presets rely on to skip work.
-#[inline]
-pub(crate) fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
-/// Linear interpolation.
-#[inline]
-pub(crate) fn lerp(a: f64, b: f64, t: f64) -> f64 {
-    a + (b - a) * t
-}
+pub(crate) use pmc_geometry::math::{lerp, smoothstep};
 
 /// The scales of a layout that the presets express their features in.
 #[derive(Clone, Copy, Debug, PartialEq)]

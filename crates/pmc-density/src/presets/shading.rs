@@ -5,15 +5,7 @@ use super::Shade;
 use crate::noise::{Fbm, FbmParams};
 use pmc_geometry::glam::DVec3;
 
-/// Converts one sRGB-encoded channel (0-255) to linear light (0-1).
-pub(crate) fn srgb_to_linear(c: u8) -> f64 {
-    let c = f64::from(c) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+pub(crate) use pmc_geometry::math::srgb_to_linear;
 
 /// A material: two colours, linear RGB in `[0, 1]`, mixed by a noise value.
 #[derive(Clone, Copy, Debug, PartialEq)]
