@@ -119,12 +119,12 @@ pub fn run(args: &FlightArgs) -> Result<(), CliError> {
         for (name, reports) in &all {
             println!("\n{name}:");
             println!(
-                "{:>8} {:>12} {:>10} {:>8} {:>7} {:>11} {:>10} {:>8}  levels drawn",
-                "stop", "height m", "converged", "select", "chunks", "triangles", "vs L0", "RSS MB"
+                "{:>8} {:>12} {:>10} {:>8} {:>7} {:>11} {:>10} {:>8} {:>6}  levels drawn",
+                "stop", "height m", "converged", "select", "chunks", "triangles", "vs L0", "RSS MB", "cores"
             );
             for r in reports {
                 println!(
-                    "{:>8} {:>12.1} {:>9.3}s {:>6.1}ms {:>7} {:>11} {:>9.1e}x {:>8}  {}",
+                    "{:>8} {:>12.1} {:>9.3}s {:>6.1}ms {:>7} {:>11} {:>9.1e}x {:>8} {:>6}  {}",
                     r.name,
                     r.height,
                     r.converged.as_secs_f64(),
@@ -134,6 +134,7 @@ pub fn run(args: &FlightArgs) -> Result<(), CliError> {
                     r.level0_triangles / (r.triangles.max(1) as f64),
                     r.peak_rss
                         .map_or("-".into(), |b| format!("{:.0}", b as f64 / 1048576.0)),
+                    r.cores_busy.map_or("-".into(), |c| format!("{c:.2}")),
                     histogram(r)
                 );
             }
@@ -170,5 +171,6 @@ fn report_json(r: &StopReport) -> serde_json::Value {
         "truncated": r.truncated,
         "retries": r.retries,
         "peak_rss_bytes": r.peak_rss,
+        "cores_busy": r.cores_busy,
     })
 }

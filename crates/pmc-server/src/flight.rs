@@ -94,6 +94,10 @@ pub struct StopReport {
     pub retries: u64,
     /// The process's peak resident memory so far, bytes (`VmHWM`), when the system tells.
     pub peak_rss: Option<u64>,
+    /// How many cores the process kept busy on average from the camera's arrival to
+    /// convergence (its CPU time over that wall time; 2.0 is two cores busy throughout), when
+    /// the system tells.
+    pub cores_busy: Option<f64>,
 }
 
 /// Why a flight failed.
@@ -130,6 +134,19 @@ pub fn peak_rss() -> Option<u64> {
     Some(kb * 1024)
 }
 
+/// The CPU time the process has used so far (user and system, all threads), seconds, from
+/// `/proc/self/stat` (in the kernel's fixed 100 ticks a second), when the system tells.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command name (which may hold spaces) are space-separated; utime and
+    // stime are the 14th and 15th of the line, the 12th and 13th after the name.
+    let rest = &s[s.rfind(')')? + 1..];
+    let mut fields = rest.split_whitespace().skip(11);
+    let utime: u64 = fields.next()?.parse().ok()?;
+    let stime: u64 = fields.next()?.parse().ok()?;
+    Some((utime + stime) as f64 / 100.0)
+}
+
 /// Flies through `stops` on the server's default planet, one after the other without clearing
 /// the cache (as a user flying down would), and measures each.
 pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Result<Vec<StopReport>, FlightError> {
@@ -145,6 +162,7 @@ pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Res
     let mut reports = Vec::with_capacity(stops.len());
     for stop in stops {
         let start = Instant::now();
+        let cpu_start = process_cpu_seconds();
         let forward = stop.look_at - stop.eye;
         let up = stop.eye.normalize_or(DVec3::Y);
         let up = if forward.cross(up).length_squared() < 1e-12 * forward.length_squared() {
@@ -201,6 +219,7 @@ pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Res
         .collect::<Vec<_>>()
         .await;
         let converged = start.elapsed();
+        let cpu = process_cpu_seconds().zip(cpu_start).map(|(b, a)| b - a);
         let after = state.stats();
         let mut drawn_per_level = vec![0usize; levels];
         let (mut triangles, mut level0, mut retries) = (0u64, 0f64, 0u64);
@@ -233,6 +252,7 @@ pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Res
             truncated: selection.truncated,
             retries,
             peak_rss: peak_rss(),
+            cores_busy: cpu.map(|c| c / converged.as_secs_f64().max(1e-9)),
         });
     }
     Ok(reports)
@@ -305,4 +325,30 @@ pub fn descent(
             }
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn process_cpu_time_counts_the_work_of_every_thread() {
+        let before = process_cpu_seconds().expect("Linux has /proc/self/stat");
+        // A fixed amount of work (a chain of 10^8 dependent multiply-adds, at least 0.1 s of
+        // CPU on any current processor) on each of two threads, however they are scheduled.
+        let spin = || {
+            let mut x = 1u64;
+            for _ in 0..100_000_000u64 {
+                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+            }
+            x
+        };
+        std::thread::scope(|s| {
+            s.spawn(spin);
+            s.spawn(spin);
+        });
+        let used = process_cpu_seconds().unwrap() - before;
+        assert!(used >= 0.1, "{used} s");
+    }
 }
