@@ -1,180 +1,44 @@
-// The viewer application: wires the API, the streamer, the scene, the camera model, the input,
-// the UI, the URL hash and the test hook together, and runs the frame loop.
+// The viewer application: wires the API, the streamer, the scene, the camera controller, the
+// input, the UI, the URL hash and the test hook together, and starts the frame loop. The planet,
+// editing and navigation state lives here; the work of a frame is frameLoop.ts's.
 
 import * as THREE from 'three';
 import { PmcApi, type PlanetInfo } from './api';
-import {
-  cameraPosition,
-  flyMove,
-  flySpeed,
-  look,
-  maxAltitude,
-  minOrbitAltitude,
-  orbitDrag,
-  orbitZoom,
-  toFly,
-  toOrbit,
-  type CameraMode,
-  type CameraState,
-} from './cameraModel';
-import { ChunkStreamer, type LodPlanet, type StreamerStats } from './chunkStreamer';
-import { formatLevels, loadRange } from './chunkSelection';
+import type { CameraMode } from './cameraModel';
+import { CameraController, type PickResult } from './cameraController';
+import { ChunkStreamer } from './chunkStreamer';
+import { formatLevels } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
 import { toolByName, toolForKey, type ToolName } from './editTools';
-import { addScaled, cameraBasis, enuAt, length, normalize, wrapLon, type V3 } from './frames';
-import { Input } from './input';
-import { Layout } from './lod/layout';
-import type { Plane } from './lod/select';
-import { LodSelector, planesToPlanetFrame, sameView, type SelectionResult, type ViewState } from './lodSelector';
-import { NavGridLoader, groundPoint, navRange, type NavGridStatus } from './navOverlay';
+import { length, normalize, type V3 } from './frames';
+import { FrameLoop } from './frameLoop';
+import { Input, type InputFrame } from './input';
+import { LodSelector } from './lodSelector';
+import { NavGridLoader, groundPoint, navRange } from './navOverlay';
 import { NavScene } from './navScene';
 import { PATH_TOOL, PathTool, type PathStatus } from './pathTool';
 import { planetParams, type PlanetParams } from './planetParams';
 import { PlanetScene, type DebugFlags } from './planetScene';
+import { Readiness } from './readiness';
+import {
+  createTestHook,
+  navGridHookOf,
+  pathHookOf,
+  type ModeName,
+  type PmcNavGridHook,
+  type PmcPathHook,
+  type PmcStats,
+  type TestHookTarget,
+} from './testHook';
 import { ToolsUi } from './toolsUi';
 import { Ui, formatDistance } from './ui';
 import { formatHash, parseHash, type UrlState } from './urlState';
+import { ViewSelection, lodPlanetOf, type LodSettings } from './viewSelection';
 
-export type ModeName = CameraMode | 'walk';
-
-/** The level-of-detail streaming as `__pmc.stats().lod` shows it. */
-export interface PmcLodStats extends Omit<StreamerStats, 'loaded' | 'pending' | 'missing' | 'triangles' | 'vertices' | 'requested' | 'failed' | 'stale' | 'reloading' | 'reloads'> {
-  /** The stats panel's histogram line, e.g. `L0 12 · L1 40 · L2 18`. */
-  levelsText: string;
-  /** The selection's settings. */
-  maxPixelError: number;
-  maxChunks: number;
-  /** The last selection's time, milliseconds, and whether one is running. */
-  selectMs: number;
-  selecting: boolean;
-  /** The last selection was made for the current view. */
-  current: boolean;
-  /** The planet has no `lod` block (an older server): level 0 everywhere. */
-  levelZeroOnly: boolean;
-}
-
-export interface PmcStats {
-  preset: string | null;
-  seed: string | null;
-  /** Chunks shown, loaded (in the cache, shown or not), pending and wanted but not asked yet. */
-  shown: number;
-  loaded: number;
-  pending: number;
-  missing: number;
-  /** Triangles and vertices shown. */
-  triangles: number;
-  vertices: number;
-  requested: number;
-  failed: number;
-  fps: number;
-  frames: number;
-  lat: number;
-  lon: number;
-  alt: number;
-  heading: number;
-  pitch: number;
-  aboveGround: number | null;
-  mode: CameraMode;
-  walk: boolean;
-  range: number;
-  drawCalls: number;
-  ready: boolean;
-  error: string | null;
-  /** The chunks shown (`face/level/i/j/k`). */
-  loadedKeys: string[];
-  /** The background colour drawn now (8-bit sRGB): what shows where nothing is drawn. */
-  background: [number, number, number];
-  lod: PmcLodStats;
-  /** Loaded chunks waiting for a refetch after an edit, refetches under way, refetches made. */
-  stale: number;
-  reloading: number;
-  reloads: number;
-  /** Whether the brush cursor is drawn. */
-  cursor: boolean;
-  edit: EditStatus;
-  /** The Path tool is chosen (the left button picks the path's ends). */
-  pathTool: boolean;
-}
-
-/** `__pmc.path()`: the Path tool's state, and where the path drawn lies on the canvas. */
-export interface PmcPathHook extends Omit<PathStatus, 'waypoints' | 'from' | 'to'> {
-  /** The ends as sent to `/path` (`LAT,LON,ALT`), null when not set. */
-  from: string | null;
-  to: string | null;
-  fromPoint: V3 | null;
-  toPoint: V3 | null;
-  /** Waypoints of the path shown. */
-  waypoints: number;
-  /** The drawn (lifted) waypoints on the canvas, CSS pixels; null where behind the camera. */
-  screen: ([number, number] | null)[];
-  /** The tool is chosen. */
-  active: boolean;
-}
-
-/** `__pmc.navgrid()`: the overlay's state. */
-export interface PmcNavGridHook extends NavGridStatus {
-  /** The overlay's objects are in the scene. */
-  drawn: boolean;
-  /** Per component: its nodes of the overlay in front of the camera and inside the canvas. */
-  onScreen: Record<number, number>;
-  /** Per component but the main one: those of them the loaded terrain does not hide. */
-  visible: Record<number, number>;
-}
-
-/** A point of the loaded terrain under a pixel. */
-export interface PickResult {
-  /** Metres from the camera along the ray. */
-  distance: number;
-  /** The point, planet frame, metres. */
-  point: V3;
-  /** The chunk hit. */
-  key: string;
-}
-
-export interface PmcTestHook {
-  stats(): PmcStats;
-  /**
-   * Resolves when the level-of-detail selection is made for the current view and exactly its
-   * chunks are shown, nothing pending.
-   */
-  ready(timeoutMs?: number): Promise<void>;
-  setCamera(lat: number, lon: number, altitude: number, headingDeg?: number, pitchDeg?: number): void;
-  setPlanet(preset: string, seed: string | number): Promise<void>;
-  /** Switches to `name` ('orbit', 'fly' or 'walk') when given; returns the current mode. */
-  mode(name?: ModeName): ModeName;
-  debug(flags: Partial<DebugFlags>): DebugFlags;
-  /** The loaded terrain under canvas pixel (x, y) (CSS pixels from the top left), or null. */
-  pick(x: number, y: number): PickResult | null;
-  /** The Path tool's state (see PmcPathHook). */
-  path(): PmcPathHook;
-  /** Turns the nav grid overlay on or off when `on` is given; returns its state. */
-  navgrid(on?: boolean): PmcNavGridHook;
-  /** Sets the largest screen-space error (pixels) and the chunk budget when given; returns them. */
-  lod(settings?: Partial<LodSettings>): LodSettings;
-}
-
-/** The selection's settings (the panel's detail fields). */
-export interface LodSettings {
-  maxPixelError: number;
-  maxChunks: number;
-}
-
-export const DEFAULT_LOD: LodSettings = { maxPixelError: 2, maxChunks: 2500 };
-
-declare global {
-  interface Window {
-    __pmc?: PmcTestHook;
-  }
-}
-
-const FOV = 50;
-const EYE_HEIGHT = 2;
-const STEP_CLIMB = 1.5;
-
-export class App {
+export class App implements TestHookTarget {
   private readonly api = new PmcApi('api/v1');
   private readonly renderer: THREE.WebGLRenderer;
-  private readonly camera = new THREE.PerspectiveCamera(FOV, 1, 0.05, 1e5);
+  private readonly cameras: CameraController;
   private readonly scene = new PlanetScene();
   private readonly navScene = new NavScene();
   private readonly pathTool: PathTool;
@@ -187,23 +51,14 @@ export class App {
   /** The world revision the path and the grid were last asked for. */
   private navRevision = 0;
   private readonly streamer: ChunkStreamer;
-  private readonly selector: LodSelector;
-  private lodPlanet: LodPlanet | null = null;
-  private levelZeroOnly = false;
-  private lodSettings: LodSettings = { ...DEFAULT_LOD };
-  /** The view of the last selection asked for, and of the previous frame. */
-  private selectedView: ViewState | null = null;
-  private lastView: ViewState | null = null;
-  private lastSelectAt = -Infinity;
-  private selectMs = 0;
+  private readonly selection: ViewSelection;
+  readonly readiness = new Readiness();
+  private readonly loop: FrameLoop;
   private readonly ui: Ui;
   private readonly toolsUi: ToolsUi;
   private readonly editor: EditSession;
   private editChanged = true;
   private readonly input: Input;
-  private readonly raycaster = new THREE.Raycaster();
-  private readonly frustum = new THREE.Frustum();
-  private readonly projView = new THREE.Matrix4();
 
   private params: PlanetParams | null = null;
   private choice: { preset?: string; seed?: string } = {};
@@ -212,26 +67,9 @@ export class App {
   private planetRequest = 0;
   private planetBusy: string | null = null;
 
-  private state: CameraState = { lat: 20, lon: 15, alt: NaN, heading: 0, pitch: -90 };
-  private mode: CameraMode = 'orbit';
-  private walk = false;
-  private speedFactor = 1;
-  private aboveGround: number | null = null;
-  private range = 1;
-
-  private lastFrame = performance.now();
-  private frames = 0;
-  private fps = 0;
-  private fpsFrames = 0;
-  private fpsSince = performance.now();
-  private lastUiUpdate = 0;
   private lastHashWrite = 0;
   private writtenHash = '';
-  private settledFrames = 0;
-  private readyWaiters: { resolve: () => void; reject: (e: Error) => void; timer: number }[] = [];
   private error: string | null = null;
-  /** The camera of the last frame, planet frame (the floating origin). */
-  private cameraPos: V3 = [0, 0, 0];
 
   constructor(private readonly canvas: HTMLCanvasElement) {
     // a logarithmic depth buffer: the same relative depth precision from 5 cm to the far side of
@@ -244,8 +82,7 @@ export class App {
     });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.renderer.outputColorSpace = THREE.SRGBColorSpace;
-    this.camera.position.set(0, 0, 0);
-    this.camera.matrixAutoUpdate = false;
+    this.cameras = new CameraController(canvas, () => this.scene.terrainMeshes());
 
     this.streamer = new ChunkStreamer(this.api, {
       onShow: (name, seams, chunk) => this.scene.addChunk(name, seams, chunk),
@@ -253,21 +90,23 @@ export class App {
       onError: (message) => this.showError(message),
       onRecovered: () => this.clearError(),
     });
-    this.selector = new LodSelector(
-      typeof Worker === 'function'
-        ? () => new Worker(new URL('./lod/worker.ts', import.meta.url), { type: 'module', name: 'pmc-lod' })
-        : null,
-      (r) => this.onSelection(r),
-      (message) => this.showError(message),
+    this.selection = new ViewSelection(
+      new LodSelector(
+        typeof Worker === 'function'
+          ? () => new Worker(new URL('./lod/worker.ts', import.meta.url), { type: 'module', name: 'pmc-lod' })
+          : null,
+        (r) => {
+          this.selection.onSelection(r);
+          this.streamer.setSelection(r.selection, r.view);
+        },
+        (message) => this.showError(message),
+      ),
     );
     this.ui = new Ui({
       onPlanet: (preset, seed) => void this.setPlanet(preset, seed).catch(() => undefined),
       onMode: (mode) => this.setMode(mode),
       onWalk: (walk) => this.setWalk(walk),
-      onDebug: (flags) => {
-        this.scene.setDebug(flags);
-        this.ui.setDebug(this.scene.debug());
-      },
+      onDebug: (flags) => this.setDebug(flags),
       onNavGrid: (on) => this.setNavGrid(on),
       onLod: (settings) => this.setLod(settings),
     });
@@ -302,28 +141,54 @@ export class App {
       onRedo: () => void this.editor.redo(),
     });
     this.input = new Input(canvas, {
-      onToggleMode: () => this.setMode(this.mode === 'orbit' ? 'fly' : 'orbit'),
+      onToggleMode: () => this.setMode(this.cameras.mode === 'orbit' ? 'fly' : 'orbit'),
       onToggleWalk: () => {
-        if (this.mode === 'fly') this.setWalk(!this.walk);
+        if (this.cameras.mode === 'fly') this.setWalk(!this.cameras.walk);
       },
       brushActive: () => this.editor.brushActive || this.pathActive,
       onShortcut: (e) => this.shortcut(e),
     });
     canvas.addEventListener('dblclick', () => {
-      if (this.mode === 'fly' && !this.editor.brushActive && !this.pathActive) this.input.requestPointerLock();
+      if (this.cameras.mode === 'fly' && !this.editor.brushActive && !this.pathActive) this.input.requestPointerLock();
     });
     window.addEventListener('resize', () => this.resize());
     window.addEventListener('hashchange', () => this.onHashChange());
     this.resize();
+    this.loop = new FrameLoop(
+      {
+        renderer: this.renderer,
+        scene: this.scene,
+        cameras: this.cameras,
+        input: this.input,
+        streamer: this.streamer,
+        selection: this.selection,
+        readiness: this.readiness,
+        ui: this.ui,
+      },
+      {
+        params: () => this.params,
+        busy: () => this.planetBusy,
+        planetLabel: () => `${this.choice.preset ?? '?'} · seed ${this.choice.seed ?? '?'}`,
+        brush: (input) => this.brushFrame(input),
+        navigation: (pos, params) => this.navFrame(pos, params),
+        editStats: () => {
+          const es = this.editor.status();
+          const et = this.editStatsText(es);
+          this.ui.setEditStats(et.text, et.push, es.error);
+        },
+        panels: (planetShown) => this.panels(planetShown),
+        moved: () => this.writeHash(false),
+      },
+    );
 
     const fromHash = parseHash(location.hash);
     this.applyUrlState(fromHash, false);
     this.choice = { ...(fromHash.preset ? { preset: fromHash.preset } : {}), ...(fromHash.seed ? { seed: fromHash.seed } : {}) };
-    this.ui.setMode(this.mode, this.walk);
+    this.ui.setMode(this.cameras.mode, this.cameras.walk);
     this.ui.setDebug(this.scene.debug());
-    this.ui.setLod(this.lodSettings);
-    window.__pmc = this.testHook();
-    this.renderer.setAnimationLoop(() => this.frame());
+    this.ui.setLod(this.selection.settings);
+    window.__pmc = createTestHook(this);
+    this.loop.start();
     void this.loadPlanet(this.choice, true);
   }
 
@@ -363,12 +228,8 @@ export class App {
     if (info.preset === null) this.servedTerrain = info.terrain?.name ?? 'elevation model';
     this.choice = { ...(info.preset !== null ? { preset: info.preset } : {}), seed: info.seed };
     const lod = lodPlanetOf(info);
-    this.lodPlanet = lod.planet;
-    this.levelZeroOnly = lod.levelZeroOnly;
     this.streamer.setPlanet(this.choice, lod.planet);
-    this.selector.setPlanet({ layout: info.layout, errors: lod.planet.errors, occluder: lod.planet.occluder });
-    this.selectedView = null;
-    this.lastView = null;
+    this.selection.setPlanet(info, lod);
     this.editor.setPlanet(info);
     this.pathTool.setPlanet(this.params.shape.datum);
     this.navLoader.reset();
@@ -376,15 +237,15 @@ export class App {
     this.scene.clearChunks();
     this.scene.setPlanet(this.params);
     const shape = this.params.shape;
-    if (!Number.isFinite(this.state.alt)) this.state.alt = 1.6 * shape.outer;
-    this.clampAltitude();
+    if (!Number.isFinite(this.cameras.state.alt)) this.cameras.state.alt = 1.6 * shape.outer;
+    this.cameras.clampAltitude(shape);
     const served = this.servedTerrain;
     const presets =
       served === null ? info.presets : [{ name: '', label: served, description: 'the real planet this server serves' }, ...info.presets];
     this.ui.setPresets(presets, info.preset ?? '');
     this.ui.setPlanet(info.preset ?? '', info.seed);
     this.planetBusy = null;
-    this.settledFrames = 0;
+    this.readiness.reset();
     this.writeHash(true);
   }
 
@@ -402,69 +263,35 @@ export class App {
 
   // ---- camera -------------------------------------------------------------------------------
 
-  private clampAltitude(): void {
-    if (!this.params) return;
-    const shape = this.params.shape;
-    const min = this.mode === 'orbit' ? minOrbitAltitude(shape) : -shape.datum + 1;
-    this.state.alt = Math.min(maxAltitude(shape), Math.max(min, this.state.alt));
-  }
-
   setMode(mode: CameraMode): void {
-    if (mode === this.mode) return;
-    this.mode = mode;
-    if (mode === 'orbit') {
-      this.walk = false;
-      this.input.releasePointerLock();
-      if (this.params) this.state = toOrbit(this.state, this.params.shape);
-    } else {
-      this.state = toFly(this.state);
-    }
-    this.clampAltitude();
-    this.ui.setMode(this.mode, this.walk);
+    if (!this.cameras.setMode(mode, this.params?.shape ?? null)) return;
+    if (mode === 'orbit') this.input.releasePointerLock();
+    this.ui.setMode(this.cameras.mode, this.cameras.walk);
     this.writeHash(true);
   }
 
   setWalk(walk: boolean): void {
-    if (walk && this.mode !== 'fly') this.setMode('fly');
-    this.walk = walk;
-    if (walk) this.state.pitch = Math.max(-60, Math.min(60, this.state.pitch));
-    this.ui.setMode(this.mode, this.walk);
+    if (walk && this.cameras.mode !== 'fly') this.setMode('fly');
+    this.cameras.setWalk(walk);
+    this.ui.setMode(this.cameras.mode, this.cameras.walk);
     this.writeHash(true);
   }
 
+  modeName(): ModeName {
+    return this.cameras.walk ? 'walk' : this.cameras.mode;
+  }
+
   setCamera(lat: number, lon: number, alt: number, heading?: number, pitch?: number): void {
-    if (![lat, lon, alt].every(Number.isFinite)) throw new Error('setCamera: lat, lon and altitude must be finite numbers');
-    const s: CameraState = {
-      lat: Math.max(-90, Math.min(90, lat)),
-      lon: wrapLon(lon),
-      alt,
-      heading: heading ?? this.state.heading,
-      pitch: pitch ?? this.state.pitch,
-    };
-    // a view that is not straight down needs the fly mode
-    if (pitch !== undefined && pitch > -89.5 && this.mode === 'orbit') {
-      this.mode = 'fly';
-      this.ui.setMode(this.mode, this.walk);
+    if (this.cameras.setCamera(lat, lon, alt, heading, pitch, this.params?.shape ?? null)) {
+      this.ui.setMode(this.cameras.mode, this.cameras.walk);
     }
-    if (this.mode === 'orbit') s.pitch = -90;
-    this.state = s;
-    this.clampAltitude();
-    this.settledFrames = 0;
+    this.readiness.reset();
     this.writeHash(true);
   }
 
   private applyUrlState(u: UrlState, fromUser: boolean): void {
-    if (u.mode) this.mode = u.mode;
-    if (u.walk !== undefined) this.walk = u.walk && this.mode === 'fly';
-    const s = this.state;
-    if (u.lat !== undefined) s.lat = u.lat;
-    if (u.lon !== undefined) s.lon = wrapLon(u.lon);
-    if (u.alt !== undefined) s.alt = u.alt;
-    if (u.heading !== undefined) s.heading = u.heading;
-    if (u.pitch !== undefined) s.pitch = Math.max(-90, Math.min(90, u.pitch));
-    if (this.mode === 'orbit') s.pitch = -90;
-    this.clampAltitude();
-    if (fromUser) this.ui.setMode(this.mode, this.walk);
+    this.cameras.applyUrlState(u, this.params?.shape ?? null);
+    if (fromUser) this.ui.setMode(this.cameras.mode, this.cameras.walk);
   }
 
   private onHashChange(): void {
@@ -482,12 +309,12 @@ export class App {
     const now = performance.now();
     if (!force && now - this.lastHashWrite < 500) return;
     this.lastHashWrite = now;
-    const s = this.state;
+    const s = this.cameras.state;
     const hash = formatHash({
       ...(this.choice.preset ? { preset: this.choice.preset } : {}),
       ...(this.choice.seed ? { seed: this.choice.seed } : {}),
-      mode: this.mode,
-      walk: this.walk,
+      mode: this.cameras.mode,
+      walk: this.cameras.walk,
       ...(Number.isFinite(s.alt) ? { lat: s.lat, lon: s.lon, alt: s.alt, heading: s.heading, pitch: s.pitch } : {}),
     });
     if (hash !== this.writtenHash && hash !== location.hash) {
@@ -562,33 +389,14 @@ export class App {
     this.navChanged = true;
   }
 
-  private readonly ndc = new THREE.Vector2();
-
   /** The loaded terrain under canvas pixel (x, y), with the camera of the last frame. */
-  private pick(x: number, y: number): (PickResult & { render: V3 }) | null {
-    const w = this.canvas.clientWidth || window.innerWidth;
-    const h = this.canvas.clientHeight || window.innerHeight;
-    if (!(w > 0 && h > 0) || !this.params) return null;
-    this.ndc.set((2 * x) / w - 1, 1 - (2 * y) / h);
-    this.raycaster.setFromCamera(this.ndc, this.camera);
-    this.raycaster.near = this.camera.near;
-    this.raycaster.far = this.camera.far;
-    const hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
-    const hit = hits[0];
-    if (!hit) return null;
-    const cam = this.cameraPos;
-    // render space is relative to the camera (floating origin): add it back in f64
-    const render: V3 = [hit.point.x, hit.point.y, hit.point.z];
-    return {
-      distance: hit.distance,
-      point: [render[0] + cam[0], render[1] + cam[1], render[2] + cam[2]],
-      key: hit.object.name,
-      render,
-    };
+  pick(x: number, y: number): (PickResult & { render: V3 }) | null {
+    if (!this.params) return null;
+    return this.cameras.pick(x, y);
   }
 
   /** The brush under the mouse: cursor, press, drag and release. */
-  private brushFrame(input: ReturnType<Input['take']>): void {
+  private brushFrame(input: InputFrame): void {
     if (this.pathActive) {
       this.scene.setBrushCursor(null);
       this.canvas.classList.add('brush');
@@ -635,7 +443,7 @@ export class App {
       this.pathTool.refresh();
     }
     if (this.navLoader.enabled) {
-      const ground = groundPoint(pos, this.aboveGround, params.shape.datum);
+      const ground = groundPoint(pos, this.cameras.aboveGround, params.shape.datum);
       const height = length(pos) - length(ground);
       this.navLoader.update({
         planet: `${this.choice.preset ?? ''}/${this.choice.seed ?? ''}`,
@@ -657,325 +465,65 @@ export class App {
     this.navScene.place(pos);
   }
 
-  /** Canvas pixel (CSS) of a planet-frame point with the camera of the last frame; null behind it. */
-  private toScreen(p: V3): [number, number] | null {
-    const cam = this.cameraPos;
-    const v = new THREE.Vector3(p[0] - cam[0], p[1] - cam[1], p[2] - cam[2]);
-    v.applyMatrix4(this.camera.matrixWorldInverse);
-    if (v.z >= 0) return null;
-    v.applyMatrix4(this.camera.projectionMatrix);
-    const w = this.canvas.clientWidth || window.innerWidth;
-    const h = this.canvas.clientHeight || window.innerHeight;
-    return [((v.x + 1) / 2) * w, ((1 - v.y) / 2) * h];
+  pathHook(): PmcPathHook {
+    return pathHookOf(this.pathTool.status(), this.navScene.drawnPath(), (p) => this.cameras.toScreen(p), this.pathActive);
   }
 
-  private pathHook(): PmcPathHook {
-    const s = this.pathTool.status();
-    const { waypoints: _w, from, to, ...rest } = s;
-    return {
-      ...rest,
-      from: from?.query ?? null,
-      to: to?.query ?? null,
-      fromPoint: from?.point ?? null,
-      toPoint: to?.point ?? null,
-      waypoints: s.waypoints.length,
-      screen: this.navScene.drawnPath().map((p) => this.toScreen(p)),
-      active: this.pathActive,
-    };
-  }
-
-  private navGridHook(): PmcNavGridHook {
-    const st = this.navLoader.status();
-    const onScreen: Record<number, number> = {};
-    const d = this.navLoader.overlay();
-    const w = this.canvas.clientWidth || window.innerWidth;
-    const h = this.canvas.clientHeight || window.innerHeight;
-    const visible: Record<number, number> = {};
-    if (d) {
-      const cam = this.cameraPos;
-      for (let i = 0; i < d.count; i++) {
-        const p: V3 = [d.origin[0] + d.positions[3 * i]!, d.origin[1] + d.positions[3 * i + 1]!, d.origin[2] + d.positions[3 * i + 2]!];
-        const px = this.toScreen(p);
-        if (!px || px[0] < 0 || px[0] >= w || px[1] < 0 || px[1] >= h) continue;
-        const label = d.labels[i]!;
-        onScreen[label] = (onScreen[label] ?? 0) + 1;
-        if (label === d.main) continue;
-        // not hidden by the terrain: nothing nearer along the ray through its pixel
-        const hit = this.pick(px[0], px[1]);
-        const dist = Math.hypot(p[0] - cam[0], p[1] - cam[1], p[2] - cam[2]);
-        if (!hit || hit.distance > dist - 0.5) visible[label] = (visible[label] ?? 0) + 1;
-      }
-    }
-    return { ...st, drawn: this.navScene.gridShown(), onScreen, visible };
+  navGridHook(): PmcNavGridHook {
+    const { width, height } = this.cameras.viewport();
+    return navGridHookOf(this.navLoader.status(), this.navLoader.overlay(), this.navScene.gridShown(), {
+      width,
+      height,
+      camera: this.cameras.position,
+      toScreen: (p) => this.cameras.toScreen(p),
+      pick: (x, y) => this.pick(x, y),
+    });
   }
 
   // ---- level of detail ------------------------------------------------------------------------
 
-  /** The selection's input for the camera of this frame (planet frame, f64). */
-  private viewState(pos: V3, forward: V3, up: V3): ViewState {
-    const planes: Plane[] = this.frustum.planes.map((p) => [p.normal.x, p.normal.y, p.normal.z, p.constant]);
-    const size = this.renderer.getDrawingBufferSize(new THREE.Vector2());
-    const lod = this.lodPlanet;
-    const total = lod ? levelZeroCount(lod.layout) : 0;
-    return {
-      view: {
-        eye: [pos[0], pos[1], pos[2]],
-        frustum: planesToPlanetFrame(planes, pos),
-        viewportHeightPx: Math.max(1, size.y),
-        fovY: (this.camera.fov * Math.PI) / 180,
-      },
-      params: {
-        maxPixelError: this.lodSettings.maxPixelError,
-        finestLevel: 0,
-        // a server without levels of detail: every level-0 chunk, however many the budget allows
-        maxChunks: this.levelZeroOnly ? Math.max(this.lodSettings.maxChunks, total) : this.lodSettings.maxChunks,
-      },
-      forward,
-      up,
-      near: this.camera.near,
-      far: this.camera.far,
-    };
-  }
-
-  /**
-   * Starts a selection when the view differs from the last one selected for and no selection is
-   * running: at once when the camera has stopped (the same view as the frame before), else at most
-   * every 150 ms while it moves.
-   */
-  private maybeSelect(view: ViewState, now: number): void {
-    if (this.lodPlanet === null || this.planetBusy !== null || this.selector.busy) return;
-    if (this.selectedView !== null && sameView(view, this.selectedView)) return;
-    const still = this.lastView !== null && sameView(view, this.lastView);
-    if (!still && now - this.lastSelectAt < 150) return;
-    if (this.selector.request(view.view, view.params)) {
-      this.selectedView = view;
-      this.lastSelectAt = now;
-    }
-  }
-
-  private onSelection(r: SelectionResult): void {
-    this.selectMs = r.ms;
-    this.streamer.setSelection(r.selection, r.view);
-  }
-
-  /** The last selection was asked for the view of the last frame and has arrived. */
-  private selectionCurrent(): boolean {
-    return (
-      !this.selector.busy && this.selectedView !== null && this.lastView !== null && sameView(this.lastView, this.selectedView)
-    );
-  }
-
   /** New selection settings: the next frame selects again. */
   setLod(settings: Partial<LodSettings>): void {
-    const px = settings.maxPixelError ?? this.lodSettings.maxPixelError;
-    const budget = settings.maxChunks ?? this.lodSettings.maxChunks;
-    if (!(Number.isFinite(px) && px > 0) || !(Number.isInteger(budget) && budget >= 1)) {
-      throw new Error('the pixel error must be a number above 0 and the chunk budget a whole number of at least 1');
-    }
-    this.lodSettings = { maxPixelError: px, maxChunks: budget };
-    this.ui.setLod(this.lodSettings);
-    this.settledFrames = 0;
+    this.selection.setSettings(settings);
+    this.ui.setLod(this.selection.settings);
+    this.readiness.reset();
   }
 
-  // ---- frame loop ---------------------------------------------------------------------------
+  lodSettings(): LodSettings {
+    return this.selection.settings;
+  }
+
+  // ---- panels -------------------------------------------------------------------------------
 
   private resize(): void {
     const w = Math.max(1, this.canvas.clientWidth || window.innerWidth);
     const h = Math.max(1, this.canvas.clientHeight || window.innerHeight);
     this.renderer.setSize(w, h, false);
-    this.camera.aspect = w / h;
-    this.camera.updateProjectionMatrix();
+    this.cameras.setAspect(w / h);
   }
 
-  /** Distance down to the loaded terrain from `from` (render space), or null without a hit. */
-  private groundDistance(from: V3, up: V3, maxDistance: number): number | null {
-    this.raycaster.near = 0;
-    this.raycaster.far = maxDistance;
-    const origin = new THREE.Vector3(from[0], from[1], from[2]);
-    const down = new THREE.Vector3(-up[0], -up[1], -up[2]);
-    this.raycaster.set(origin, down);
-    let hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
-    if (hits.length === 0) {
-      // A ray exactly along a chunk border (a face's centre line: chunks of every level meet
-      // there) can pass between the two chunks' triangles, whose float32 vertices are relative
-      // to different origins: tilt it by a microradian and try once more.
-      const side = Math.abs(up[1]) < 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0);
-      down.addScaledVector(side.cross(down).normalize(), 1e-6).normalize();
-      this.raycaster.set(origin, down);
-      hits = this.raycaster.intersectObjects(this.scene.terrainMeshes(), false);
-    }
-    return hits.length > 0 ? hits[0]!.distance : null;
+  setDebug(flags: Partial<DebugFlags>): DebugFlags {
+    this.scene.setDebug(flags);
+    this.ui.setDebug(this.scene.debug());
+    return this.scene.debug();
   }
 
-  private frame(): void {
-    const now = performance.now();
-    const dt = Math.min(0.1, Math.max(0, (now - this.lastFrame) / 1000));
-    this.lastFrame = now;
-    this.frames++;
-    this.fpsFrames++;
-    if (now - this.fpsSince >= 500) {
-      this.fps = (this.fpsFrames * 1000) / (now - this.fpsSince);
-      this.fpsFrames = 0;
-      this.fpsSince = now;
-    }
-    const params = this.params;
-    const input = this.input.take();
-    if (!params) {
-      this.renderer.render(this.scene.scene, this.camera);
-      this.ui.setLoading(0, 0, this.planetBusy ?? 'waiting for the server');
-      if (this.editChanged) {
-        this.editChanged = false;
-        this.toolsUi.update(this.editor.status(), this.pathActive);
-        this.toolsUi.setPath(this.pathTool.status(), this.pathActive);
-      }
-      return;
-    }
-    const shape = params.shape;
-    const viewportHeight = this.canvas.clientHeight || window.innerHeight;
-    let moved = false;
-    if (this.mode === 'orbit') {
-      if (input.dragX !== 0 || input.dragY !== 0) {
-        this.state = orbitDrag(this.state, shape, input.dragX, input.dragY, viewportHeight, FOV);
-        moved = true;
-      }
-      if (input.wheel !== 0) {
-        this.state = orbitZoom(this.state, shape, input.wheel);
-        moved = true;
-      }
-    } else {
-      if (input.dragX !== 0 || input.dragY !== 0) {
-        this.state = look(this.state, input.dragX * 0.15, -input.dragY * 0.15);
-        if (this.walk) this.state.pitch = Math.max(-80, Math.min(80, this.state.pitch));
-        moved = true;
-      }
-      if (input.wheel !== 0) {
-        this.speedFactor = Math.min(100, Math.max(0.01, this.speedFactor * Math.exp(-input.wheel * 0.001)));
-      }
-      if (input.forward !== 0 || input.right !== 0 || input.up !== 0) {
-        const r = length(cameraPosition(this.state, shape));
-        const height = this.aboveGround ?? Math.max(1, r - shape.outer);
-        const speed = flySpeed(this.walk ? 3 : height) * this.speedFactor * (input.fast ? 4 : 1);
-        this.state = flyMove(this.state, shape, input, dt, speed, this.walk).state;
-        moved = true;
-      }
-    }
-    this.clampAltitude();
-    let pos = cameraPosition(this.state, shape);
-    this.scene.place(pos);
-    this.scene.scene.updateMatrixWorld();
-
-    // ground: walk snaps the eye above it; fly measures it (every few frames)
-    const up = normalize(pos);
-    if (this.walk) {
-      const probe = STEP_CLIMB - EYE_HEIGHT; // ray origin relative to the eye, along up
-      const d = this.groundDistance(addScaled([0, 0, 0], up, probe), up, 5000);
-      if (d !== null) {
-        const below = d - probe; // height of the eye above the ground now
-        const want = EYE_HEIGHT - below;
-        // climb at once, fall at most 25 m/s
-        const adjust = want > 0 ? want : Math.max(want, -25 * Math.max(dt, 1 / 60));
-        this.state.alt += adjust;
-        this.aboveGround = below + adjust;
-        pos = cameraPosition(this.state, shape);
-        this.scene.place(pos);
-        this.scene.scene.updateMatrixWorld();
-        moved = true;
-      }
-    } else if (this.mode === 'fly' && (this.frames % 6 === 0 || moved)) {
-      this.aboveGround = this.groundDistance([0, 0, 0], up, 4 * shape.outer);
-    } else if (this.mode === 'orbit') {
-      this.aboveGround = null;
-    }
-
-    // camera orientation and clip planes
-    const basis = cameraBasis(pos, this.state.heading, this.state.pitch);
-    const m = new THREE.Matrix4().makeBasis(
-      new THREE.Vector3(...basis.right),
-      new THREE.Vector3(...basis.up),
-      new THREE.Vector3(-basis.forward[0], -basis.forward[1], -basis.forward[2]),
-    );
-    this.camera.matrix.copy(m);
-    this.camera.matrixWorld.copy(m);
-    this.camera.matrixWorldInverse.copy(m).invert();
-    // clip planes: with the logarithmic depth buffer only the far plane's order of magnitude
-    // matters for precision; near stays a few centimetres up to a tenth of the height above the
-    // highest terrain (or the ground measured below), far reaches past the horizon
-    const r = length(pos);
-    const clearance = Math.max(r - shape.outer, this.aboveGround ?? 0);
-    this.camera.near = Math.min(1e4, Math.max(0.05, 0.1 * clearance));
-    this.range = loadRange(r, params.extent, Math.max(4 * params.chunkWidth, 100));
-    this.camera.far = Math.max(this.camera.near * 10, this.range * 1.05 + params.chunkWidth);
-    this.camera.updateProjectionMatrix();
-    this.cameraPos = pos;
-    this.brushFrame(input);
-    this.navFrame(pos, params);
-
-    // sky: blue near the ground, black from orbit
-    const aboveSea = r - (params.seaRadius ?? shape.datum);
-    const skyT = (aboveSea - 0.04 * shape.datum) / (0.5 * shape.datum);
-    this.scene.setSky(1 - Math.max(0, Math.min(1, skyT)) ** 0.5);
-
-    // sun: above the camera's side of the planet, from the south-east-ish
-    const enu = enuAt(pos);
-    this.scene.setSun(normalize(addScaled(addScaled(enu.up, enu.east, 0.55), enu.north, 0.35)));
-
-    // streaming: select for this view (when it changed), fetch and show
-    this.projView.multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse);
-    this.frustum.setFromProjectionMatrix(this.projView);
-    const view = this.viewState(pos, basis.forward, basis.up);
-    this.maybeSelect(view, now);
-    this.lastView = view;
-    this.streamer.update();
-
-    this.renderer.render(this.scene.scene, this.camera);
-
-    const st = this.streamer.stats();
-    const settled = this.planetBusy === null && this.selectionCurrent() && this.streamer.settled();
-    this.settledFrames = settled ? this.settledFrames + 1 : 0;
-    if (this.settledFrames >= 2 && this.readyWaiters.length > 0) {
-      const waiters = this.readyWaiters;
-      this.readyWaiters = [];
-      for (const w of waiters) {
-        clearTimeout(w.timer);
-        w.resolve();
-      }
-    }
-    if (now - this.lastUiUpdate > 200) {
-      this.lastUiUpdate = now;
-      this.ui.setStats({
-        planet: `${this.choice.preset ?? '?'} · seed ${this.choice.seed ?? '?'}`,
-        chunks: st.shown,
-        loaded: st.loaded,
-        pending: st.pending,
-        levels: formatLevels(st.levels),
-        triangles: st.triangles,
-        fps: this.fps,
-        lat: this.state.lat,
-        lon: this.state.lon,
-        alt: this.state.alt,
-        aboveGround: this.aboveGround,
-        heading: this.state.heading,
-      });
-      this.ui.setLoading(st.pending, st.missing, this.planetBusy);
-      const es = this.editor.status();
-      const et = this.editStatsText(es);
-      this.ui.setEditStats(et.text, et.push, es.error);
-    }
+  /** The tools panel (and, with a planet shown, the path and nav grid lines) where they changed. */
+  private panels(planetShown: boolean): void {
     if (this.editChanged) {
       this.editChanged = false;
       this.toolsUi.update(this.editor.status(), this.pathActive);
       const ps = this.pathTool.status();
       this.toolsUi.setPath(ps, this.pathActive);
-      this.ui.setPathStats(pathStatsText(ps));
+      if (planetShown) this.ui.setPathStats(pathStatsText(ps));
     }
-    if (this.navChanged) {
+    if (planetShown && this.navChanged) {
       this.navChanged = false;
       this.ui.setNavGrid(this.navLoader.status());
     }
-    if (moved) this.writeHash(false);
   }
 
-  // ---- errors and the test hook -------------------------------------------------------------
+  // ---- errors and stats ---------------------------------------------------------------------
 
   private showError(message: string): void {
     this.error = message;
@@ -993,6 +541,7 @@ export class App {
       loaded: _l, pending: _p, missing: _m, triangles: _t, vertices: _v, requested: _r, failed: _f, stale: _s, reloading: _g, reloads: _d,
       ...lod
     } = st;
+    const cam = this.cameras;
     return {
       preset: this.choice.preset ?? null,
       seed: this.choice.seed ?? null,
@@ -1004,30 +553,30 @@ export class App {
       vertices: st.vertices,
       requested: st.requested,
       failed: st.failed,
-      fps: this.fps,
-      frames: this.frames,
-      lat: this.state.lat,
-      lon: this.state.lon,
-      alt: this.state.alt,
-      heading: this.state.heading,
-      pitch: this.state.pitch,
-      aboveGround: this.aboveGround,
-      mode: this.mode,
-      walk: this.walk,
-      range: this.range,
+      fps: this.loop.fps,
+      frames: this.loop.frames,
+      lat: cam.state.lat,
+      lon: cam.state.lon,
+      alt: cam.state.alt,
+      heading: cam.state.heading,
+      pitch: cam.state.pitch,
+      aboveGround: cam.aboveGround,
+      mode: cam.mode,
+      walk: cam.walk,
+      range: cam.range,
       drawCalls: this.renderer.info.render.calls,
-      ready: this.settledFrames >= 2,
+      ready: this.readiness.ready,
       error: this.error,
       loadedKeys: this.streamer.shownNames(),
       background: this.scene.backgroundRgb(),
       lod: {
         ...lod,
         levelsText: formatLevels(st.levels),
-        ...this.lodSettings,
-        selectMs: this.selectMs,
-        selecting: this.selector.busy,
-        current: this.selectionCurrent(),
-        levelZeroOnly: this.levelZeroOnly,
+        ...this.selection.settings,
+        selectMs: this.selection.selectMs,
+        selecting: this.selection.busy,
+        current: this.selection.current(),
+        levelZeroOnly: this.selection.levelZeroOnly,
       },
       stale: st.stale,
       reloading: st.reloading,
@@ -1037,74 +586,6 @@ export class App {
       pathTool: this.pathActive,
     };
   }
-
-  private testHook(): PmcTestHook {
-    return {
-      stats: () => this.stats(),
-      ready: (timeoutMs = 120_000) =>
-        new Promise<void>((resolve, reject) => {
-          this.settledFrames = Math.min(this.settledFrames, 1);
-          const timer = window.setTimeout(() => {
-            this.readyWaiters = this.readyWaiters.filter((w) => w.timer !== timer);
-            const s = this.stats();
-            reject(
-              new Error(
-                `__pmc.ready() timed out after ${timeoutMs} ms (loaded ${s.loaded}, pending ${s.pending}, ` +
-                  `missing ${s.missing}, error ${String(s.error)})`,
-              ),
-            );
-          }, timeoutMs);
-          this.readyWaiters.push({ resolve, reject, timer });
-        }),
-      setCamera: (lat, lon, alt, heading, pitch) => this.setCamera(lat, lon, alt, heading, pitch),
-      setPlanet: (preset, seed) => this.setPlanet(preset, String(seed)),
-      mode: (name) => {
-        if (name === 'walk') this.setWalk(true);
-        else if (name === 'fly') {
-          this.setMode('fly');
-          this.setWalk(false);
-        } else if (name === 'orbit') this.setMode('orbit');
-        return this.walk ? 'walk' : this.mode;
-      },
-      debug: (flags) => {
-        this.scene.setDebug(flags);
-        this.ui.setDebug(this.scene.debug());
-        return this.scene.debug();
-      },
-      pick: (x, y) => {
-        const p = this.pick(x, y);
-        return p ? { distance: p.distance, point: p.point, key: p.key } : null;
-      },
-      path: () => this.pathHook(),
-      navgrid: (on) => {
-        if (on !== undefined) this.setNavGrid(on);
-        return this.navGridHook();
-      },
-      lod: (settings) => {
-        if (settings) this.setLod(settings);
-        return { ...this.lodSettings };
-      },
-    };
-  }
-}
-
-/** The chunks of level 0 of a layout. */
-function levelZeroCount(layout: Layout): number {
-  return 6 * layout.chunksPerSide(0) ** 2 * layout.depthChunks(0);
-}
-
-/**
- * The level-of-detail data of a planet: `/planet`'s `lod` block, or, from a server without one
- * (every level 0 and nothing else), a table that refines everything to level 0.
- */
-export function lodPlanetOf(info: PlanetInfo): { planet: LodPlanet; levelZeroOnly: boolean } {
-  const layout = new Layout(info.layout);
-  const lod = info.lod;
-  if (lod && lod.errors.length === layout.maxLevel() + 1) {
-    return { planet: { layout, errors: [...lod.errors], occluder: lod.occluder_radius }, levelZeroOnly: false };
-  }
-  const errors = Array.from({ length: layout.maxLevel() + 1 }, (_, l) => (l === 0 ? 0 : 1e30));
-  return { planet: { layout, errors, occluder: info.surface_bounds?.[0] ?? info.base_radius }, levelZeroOnly: true };
 }
 
 /** The path row of the stats panel. */

@@ -1,0 +1,121 @@
+// The browser of the steps: headless Chromium with one page, watched for console errors and
+// warnings, uncaught errors and failed responses, and the helpers the steps drive pages with (the
+// test hook `window.__pmc`, waiting for a settled view, screenshots).
+
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { chromium } from 'playwright-core';
+import { CHROMIUM, CHROMIUM_ARGS, READY_MS, VIEWPORT, artifacts, check, cleanups, log, withTimeout } from './harness.mjs';
+import { decodePng } from './images.mjs';
+
+/** Launches Chromium; returns its first page and the helpers, shared by every step. */
+export async function openBrowser() {
+  const profile = mkdtempSync(join(tmpdir(), 'pmc-e2e-chromium-'));
+  cleanups.push(() => rmSync(profile, { recursive: true, force: true }));
+  log(`launching ${CHROMIUM}`);
+  const context = await withTimeout(
+    chromium.launchPersistentContext(profile, {
+      executablePath: CHROMIUM,
+      headless: true,
+      viewport: VIEWPORT,
+      deviceScaleFactor: 1,
+      args: CHROMIUM_ARGS,
+    }),
+    60_000,
+    'launching Chromium',
+  );
+  cleanups.push(() => context.close());
+  const page = context.pages()[0] ?? (await context.newPage());
+  page.setDefaultTimeout(60_000);
+
+  const consoleProblems = [];
+  /** URLs whose failure a test provokes on purpose. */
+  const expectedFailures = [];
+  // Chromium's software compositor reads the WebGL canvas back to composite it, and the GL driver
+  // says so as a console warning; it comes from the browser set-up, not from the page.
+  const environmental = /GL Driver Message \(OpenGL, Performance, .*\): GPU stall due to ReadPixels/;
+  const failedResponses = [];
+  /** Collects console errors and warnings, uncaught errors and failed responses of `p`. */
+  const watchPage = (p, label = '') => {
+    const tag = label ? `[${label}] ` : '';
+    p.on('console', (m) => {
+      if (m.type() !== 'error' && m.type() !== 'warning') return;
+      if (environmental.test(m.text())) return;
+      if (expectedFailures.some((re) => re.test(m.location()?.url ?? ''))) return;
+      consoleProblems.push(`${tag}${m.type()}: ${m.text()}`);
+    });
+    p.on('pageerror', (e) => consoleProblems.push(`${tag}uncaught: ${e.message}`));
+    p.on('response', (r) => {
+      if (r.status() >= 400 && !expectedFailures.some((re) => re.test(r.url()))) failedResponses.push(`${tag}${r.status()} ${r.url()}`);
+    });
+  };
+  watchPage(page);
+  const chunkRequests = [];
+  page.on('request', (r) => {
+    if (r.url().includes('/api/v1/chunk/')) chunkRequests.push(r.url());
+  });
+
+  const hookOn = (p) => (fn, arg) => withTimeout(p.evaluate(fn, arg), READY_MS + 10_000, 'page.evaluate');
+  const hook = hookOn(page);
+  const readyOn = async (p, what) => {
+    const t0 = Date.now();
+    await hookOn(p)((ms) => window.__pmc.ready(ms), READY_MS);
+    const s = await hookOn(p)(() => window.__pmc.stats());
+    log(`  ready ${what}: ${s.loaded} chunks, ${s.triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+    return s;
+  };
+  const ready = (what) => readyOn(page, what);
+  /** Waits for `pred(arg)` in page `p`; a timeout says what `state()` (in the page) shows then. */
+  const waitFor = async (p, what, pred, arg, state, ms = 30_000) => {
+    try {
+      await p.waitForFunction(pred, arg, { timeout: ms, polling: 100 });
+    } catch (e) {
+      const now = await hookOn(p)(state).catch((err) => `(no state: ${err.message})`);
+      throw new Error(`${what}: not within ${ms / 1000} s; now ${JSON.stringify(now).slice(0, 600)}`);
+    }
+  };
+  const pathState = () => { const { screen: _s, ...rest } = window.__pmc.path(); return rest; };
+  const gridState = () => { const { components, onScreen: _o, visible: _v, ...rest } = window.__pmc.navgrid(); return { ...rest, components: components.length }; };
+  /** A screenshot of the view of `p` alone (panels hidden), saved under e2e/artifacts. */
+  const shotOf = async (p, name) => {
+    await p.addStyleTag({ content: '.panel, #loading, #error { visibility: hidden !important; }' }).then((h) => h.evaluate((el) => el.setAttribute('id', 'e2e-hide')));
+    // two more frames so the last chunks are on screen
+    await hookOn(p)(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(() => r()))));
+    const buf = await p.screenshot({ type: 'png', timeout: 60_000 });
+    await p.evaluate(() => document.getElementById('e2e-hide')?.remove());
+    writeFileSync(join(artifacts, `${name}.png`), buf);
+    return decodePng(buf);
+  };
+  const shot = (name) => shotOf(page, name);
+  /** The harness of the level-of-detail flights (e2e/lodFlight.mjs). */
+  const flightHarness = {
+    page,
+    hook,
+    ready,
+    shot,
+    log,
+    check,
+    problems: () => [...consoleProblems, ...failedResponses],
+  };
+
+  return {
+    context,
+    page,
+    consoleProblems,
+    expectedFailures,
+    failedResponses,
+    watchPage,
+    chunkRequests,
+    hookOn,
+    hook,
+    readyOn,
+    ready,
+    waitFor,
+    pathState,
+    gridState,
+    shotOf,
+    shot,
+    flightHarness,
+  };
+}

@@ -1,0 +1,117 @@
+// The end-to-end harness: the settings from the environment (see run.mjs), the log, the clean-ups
+// run on every exit, timeouts, child processes, and the steps with their results.
+
+import { spawn } from 'node:child_process';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = dirname(fileURLToPath(import.meta.url));
+export const viewerDir = resolve(here, '..');
+export const distDir = join(viewerDir, 'dist');
+export const artifacts = join(here, 'artifacts');
+// PMC_BIN is relative to the working directory; the default to the repository's target/
+export const PMC_BIN = process.env.PMC_BIN ? resolve(process.env.PMC_BIN) : resolve(viewerDir, '../target/release/pmc');
+export const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
+export const USE_MOCK = process.env.PMC_E2E_MOCK === '1';
+export const LAYOUT = { n_c: 4, n_t: 16 };
+export const VIEWPORT = { width: 1024, height: 640 };
+export const READY_MS = 240_000;
+/** The headless Chromium of every test: software WebGL, nothing from outside. */
+export const CHROMIUM_ARGS = [
+  '--no-sandbox',
+  '--disable-gpu',
+  '--use-angle=swiftshader',
+  '--enable-unsafe-swiftshader',
+  '--disable-background-networking',
+  '--disable-component-update',
+  '--disable-sync',
+  '--no-first-run',
+  '--disable-quic',
+];
+export const TOTAL_MS = 20 * 60_000;
+
+export const started = Date.now();
+export const log = (msg) => console.log(`[e2e ${((Date.now() - started) / 1000).toFixed(1)}s] ${msg}`);
+/** Run last to first at the end, whatever happens: servers and browsers stopped, files removed. */
+export const cleanups = [];
+let exiting = false;
+
+export async function cleanup() {
+  while (cleanups.length > 0) {
+    const fn = cleanups.pop();
+    try {
+      await fn();
+    } catch (e) {
+      console.error(`cleanup: ${e?.message ?? e}`);
+    }
+  }
+}
+
+export async function fail(message) {
+  if (exiting) return;
+  exiting = true;
+  console.error(`\nE2E FAILED: ${message}`);
+  await cleanup();
+  process.exit(1);
+}
+
+export function withTimeout(promise, ms, what) {
+  let timer;
+  return Promise.race([
+    promise.finally(() => clearTimeout(timer)),
+    new Promise((_, reject) => {
+      timer = setTimeout(() => reject(new Error(`${what}: no answer within ${ms / 1000} s`)), ms);
+    }),
+  ]);
+}
+
+export async function fetchText(url, ms = 5000) {
+  const res = await withTimeout(fetch(url), ms, `GET ${url}`);
+  return { status: res.status, text: await res.text() };
+}
+
+export async function run(cmd, args, ms) {
+  return withTimeout(
+    new Promise((res) => {
+      const p = spawn(cmd, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+      let out = '';
+      p.stdout.on('data', (d) => (out += d));
+      p.stderr.on('data', (d) => (out += d));
+      p.on('error', (e) => res({ code: -1, out: String(e) }));
+      p.on('close', (code) => res({ code, out }));
+    }),
+    ms,
+    `${cmd} ${args.join(' ')}`,
+  );
+}
+
+// ---- the steps -------------------------------------------------------------------------------
+
+export const results = [];
+/** PMC_E2E_ONLY: a comma-separated list of step numbers to run alone, while working on them. */
+const ONLY = process.env.PMC_E2E_ONLY ? new Set(process.env.PMC_E2E_ONLY.split(',').map((x) => x.trim())) : null;
+export async function step(name, fn) {
+  if (ONLY && !ONLY.has(name.split('.')[0])) return;
+  const t0 = Date.now();
+  log(`▶ ${name}`);
+  try {
+    await fn();
+    results.push({ name, ok: true, s: (Date.now() - t0) / 1000 });
+    log(`✔ ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
+  } catch (e) {
+    results.push({ name, ok: false, s: (Date.now() - t0) / 1000, error: short(e) });
+    log(`✘ ${name}: ${short(e)}`);
+    throw new Error(`${name}: ${short(e)}`);
+  }
+}
+
+/** An error's message without the browser log Playwright appends to it. */
+export function short(e) {
+  const m = String(e?.message ?? e);
+  const cut = m.search(/\n(Browser logs:|=+ logs =+|Call log:)/);
+  return (cut >= 0 ? m.slice(0, cut) : m).slice(0, 2000);
+}
+
+export function check(cond, message) {
+  if (!cond) throw new Error(message);
+}

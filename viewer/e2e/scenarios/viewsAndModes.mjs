@@ -1,0 +1,73 @@
+// Step 6: debug views, mode switch, walk mode and the URL hash.
+
+import { check, log } from '../harness.mjs';
+import { fractionDifferent } from '../images.mjs';
+
+export const name = '6. debug views, mode switch, walk mode and the URL hash';
+
+export async function scenario(t) {
+  const { page, consoleProblems, expectedFailures, hook, ready, shot } = t;
+  await hook(() => window.__pmc.setCamera(20, 15, 3000, 0, -90));
+  await hook(() => window.__pmc.mode('orbit'));
+  await ready('orbit again');
+  const plain = await shot('debug-none');
+  for (const [id, name] of [['#faces', 'faces'], ['#wireframe', 'wireframe'], ['#borders', 'borders']]) {
+    await page.click(id);
+    const img = await shot(`debug-${name}`);
+    const diff = fractionDifferent(plain, img);
+    log(`  ${name}: ${(100 * diff).toFixed(1)} % of the pixels changed`);
+    // the borders are thin lines around each chunk drawn; with levels of detail the view from
+    // 3 km holds a few dozen large chunks, so they cover about 1 % of the picture
+    const least = name === 'borders' ? 0.004 : 0.02;
+    check(diff > least, `toggling ${name} changed only ${(100 * diff).toFixed(2)} % of the pixels`);
+    await page.click(id);
+  }
+  const flags = await hook(() => window.__pmc.debug({}));
+  check(!flags.wireframe && !flags.faceColours && !flags.borders, `debug flags left on: ${JSON.stringify(flags)}`);
+
+  // Tab switches to fly, the button back to orbit
+  await page.click('#view');
+  await page.keyboard.press('Tab');
+  check((await hook(() => window.__pmc.stats())).mode === 'fly', 'Tab did not switch to fly');
+  await page.click('#mode');
+  check((await hook(() => window.__pmc.stats())).mode === 'orbit', 'the mode button did not switch to orbit');
+
+  // walk: the eye settles about 2 m above the ground and W moves it along
+  await hook(() => window.__pmc.setCamera(-10, 8, 80, 90, -5));
+  await hook(() => window.__pmc.mode('walk'));
+  await ready('walking');
+  await page.waitForFunction(() => Math.abs((window.__pmc.stats().aboveGround ?? 99) - 2) < 0.25, null, { timeout: 60_000 });
+  const w0 = await hook(() => window.__pmc.stats());
+  await page.keyboard.down('KeyW');
+  await page.waitForFunction((lon) => Math.abs(window.__pmc.stats().lon - lon) > 0.02, w0.lon, { timeout: 60_000 });
+  await page.keyboard.up('KeyW');
+  await page.waitForFunction(() => Math.abs((window.__pmc.stats().aboveGround ?? 99) - 2) < 0.25, null, { timeout: 60_000 });
+  const w1 = await hook(() => window.__pmc.stats());
+  log(`  walked from lon ${w0.lon.toFixed(4)} to ${w1.lon.toFixed(4)}, altitude ${w0.alt.toFixed(1)} -> ${w1.alt.toFixed(1)} m, ${w1.aboveGround.toFixed(2)} m above the ground`);
+  check(w1.walk && w1.mode === 'fly', `walk mode lost: ${w1.mode}, walk ${w1.walk}`);
+  await shot('walk');
+
+  // a reload keeps the planet, the mode and the camera
+  await page.waitForFunction(() => location.hash.includes('walk=1'), null, { timeout: 10_000 });
+  const hash = await page.evaluate(() => location.hash);
+  await page.reload({ waitUntil: 'load' });
+  await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+  const r = await ready('after reload');
+  log(`  ${hash}`);
+  check(r.preset === 'earthlike' && r.seed === '7' && r.walk, `reload lost the state: ${r.preset}/${r.seed} walk ${r.walk}`);
+  check(Math.abs(r.lat - w1.lat) < 1e-3 && Math.abs(r.lon - w1.lon) < 1e-3, `reload moved the camera: ${r.lat},${r.lon} vs ${w1.lat},${w1.lon}`);
+
+  // an API error shows a message and keeps the planet
+  expectedFailures.push(/preset=venus/);
+  const err = await hook(() => window.__pmc.setPlanet('venus', '7').then(() => null, (e) => String(e.message)));
+  check(err !== null, 'setPlanet("venus") did not fail');
+  const banner = await page.evaluate(() => (document.getElementById('error').hidden ? null : document.getElementById('error-text').textContent));
+  log(`  error banner: ${banner}`);
+  check(banner !== null && banner.includes('venus'), `no visible error message for an unknown preset (banner: ${banner})`);
+  const after = await hook(() => window.__pmc.stats());
+  check(after.preset === 'earthlike' && after.loaded > 0, `the planet changed after a failed switch: ${after.preset}, ${after.loaded} chunks`);
+  check((await page.inputValue('#preset')) === 'earthlike', 'the preset picker does not show the current planet');
+  await page.click('#error-close');
+  check(await page.isHidden('#error'), 'the error banner does not close');
+  check(consoleProblems.length === 0, `console messages:\n  ${consoleProblems.join('\n  ')}`);
+}

@@ -1,0 +1,139 @@
+// The frame loop: every animation frame moves the camera by the input and places the scene around
+// it (the floating origin), runs the brush and the navigation overlay, sets the sky and the sun,
+// asks for the level-of-detail selection of the view and streams its chunks, renders, counts the
+// settled frames `__pmc.ready()` waits for and refreshes the panels.
+
+import * as THREE from 'three';
+import type { CameraController } from './cameraController';
+import { formatLevels } from './chunkSelection';
+import type { ChunkStreamer } from './chunkStreamer';
+import { addScaled, enuAt, length, normalize, type V3 } from './frames';
+import type { Input, InputFrame } from './input';
+import type { PlanetParams } from './planetParams';
+import type { PlanetScene } from './planetScene';
+import type { Readiness } from './readiness';
+import type { Ui } from './ui';
+import type { ViewSelection } from './viewSelection';
+
+/** What a frame works with. */
+export interface FrameParts {
+  renderer: THREE.WebGLRenderer;
+  scene: PlanetScene;
+  cameras: CameraController;
+  input: Input;
+  streamer: ChunkStreamer;
+  selection: ViewSelection;
+  readiness: Readiness;
+  ui: Ui;
+}
+
+/** The application's part of a frame. */
+export interface FrameSteps {
+  /** The planet shown; null until one is loaded. */
+  params(): PlanetParams | null;
+  /** What the planet is busy with (e.g. 'loading planet'), null when nothing. */
+  busy(): string | null;
+  /** The stats panel's planet line. */
+  planetLabel(): string;
+  /** The brush (or the Path tool) under the mouse, with the camera of this frame. */
+  brush(input: InputFrame): void;
+  /** The path and the nav grid overlay around the camera at `pos`. */
+  navigation(pos: V3, params: PlanetParams): void;
+  /** The stats panel's editing line. */
+  editStats(): void;
+  /** The tools panel (and, with `planetShown`, the path and nav grid lines) where they changed. */
+  panels(planetShown: boolean): void;
+  /** The camera moved this frame. */
+  moved(): void;
+}
+
+export class FrameLoop {
+  /** Frames drawn, and frames per second over the last half second or so. */
+  frames = 0;
+  fps = 0;
+  private lastFrame = performance.now();
+  private fpsFrames = 0;
+  private fpsSince = performance.now();
+  private lastUiUpdate = 0;
+
+  constructor(
+    private readonly parts: FrameParts,
+    private readonly steps: FrameSteps,
+  ) {}
+
+  start(): void {
+    this.parts.renderer.setAnimationLoop(() => this.frame());
+  }
+
+  private frame(): void {
+    const { renderer, scene, cameras, input: inputs, streamer, selection, readiness, ui } = this.parts;
+    const steps = this.steps;
+    const now = performance.now();
+    const dt = Math.min(0.1, Math.max(0, (now - this.lastFrame) / 1000));
+    this.lastFrame = now;
+    this.frames++;
+    this.fpsFrames++;
+    if (now - this.fpsSince >= 500) {
+      this.fps = (this.fpsFrames * 1000) / (now - this.fpsSince);
+      this.fpsFrames = 0;
+      this.fpsSince = now;
+    }
+    const params = steps.params();
+    const input = inputs.take();
+    if (!params) {
+      renderer.render(scene.scene, cameras.camera);
+      ui.setLoading(0, 0, steps.busy() ?? 'waiting for the server');
+      steps.panels(false);
+      return;
+    }
+    const shape = params.shape;
+    const { pos, basis, moved } = cameras.frame(input, params, dt, this.frames, (p) => {
+      scene.place(p);
+      scene.scene.updateMatrixWorld();
+    });
+    steps.brush(input);
+    steps.navigation(pos, params);
+
+    // sky: blue near the ground, black from orbit
+    const r = length(pos);
+    const aboveSea = r - (params.seaRadius ?? shape.datum);
+    const skyT = (aboveSea - 0.04 * shape.datum) / (0.5 * shape.datum);
+    scene.setSky(1 - Math.max(0, Math.min(1, skyT)) ** 0.5);
+
+    // sun: above the camera's side of the planet, from the south-east-ish
+    const enu = enuAt(pos);
+    scene.setSun(normalize(addScaled(addScaled(enu.up, enu.east, 0.55), enu.north, 0.35)));
+
+    // streaming: select for this view (when it changed), fetch and show
+    const viewportHeightPx = renderer.getDrawingBufferSize(new THREE.Vector2()).y;
+    selection.frame(cameras.camera, viewportHeightPx, pos, basis.forward, basis.up, now, steps.busy() !== null);
+    streamer.update();
+
+    renderer.render(scene.scene, cameras.camera);
+
+    const st = streamer.stats();
+    readiness.frame(steps.busy() === null && selection.current() && streamer.settled());
+    if (now - this.lastUiUpdate > 200) {
+      this.lastUiUpdate = now;
+      const s = cameras.state;
+      ui.setStats({
+        planet: steps.planetLabel(),
+        chunks: st.shown,
+        loaded: st.loaded,
+        pending: st.pending,
+        levels: formatLevels(st.levels),
+        triangles: st.triangles,
+        fps: this.fps,
+        lat: s.lat,
+        lon: s.lon,
+        alt: s.alt,
+        aboveGround: cameras.aboveGround,
+        heading: s.heading,
+      });
+      ui.setLoading(st.pending, st.missing, steps.busy());
+      steps.editStats();
+    }
+    steps.panels(true);
+    if (moved) steps.moved();
+  }
+}
