@@ -123,6 +123,38 @@ fn noise(c: &mut Criterion) {
             })
         });
     }
+    // The same sums at scattered points (no two neighbours in one cell, even in the coarsest
+    // octave): the worst case for the slice kernel, which reuses a group's corner gradients
+    // while the next group stays in its cells (as a chunk's or a patch's points do).
+    let scattered: Vec<DVec3> = (0..SAMPLES as u64)
+        .map(|i| {
+            let h = |k: u64| pmc_density::noise::unit_f64(pmc_density::noise::mix64(i * 3 + k)) * 2.0 - 1.0;
+            DVec3::new(h(1), h(2), h(3)).normalize()
+        })
+        .collect();
+    let (sx, sy, sz): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+        scattered.iter().map(|d| d.x).collect(),
+        scattered.iter().map(|d| d.y).collect(),
+        scattered.iter().map(|d| d.z).collect(),
+    );
+    g.bench_function("fbm6/slices/scattered/samples=1024", |b| {
+        b.iter(|| {
+            fbm.sample_slices(&sx, &sy, &sz, &mut out);
+            black_box(out.iter().sum::<f64>())
+        })
+    });
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        let scaled = |v: &[f64]| -> Vec<f32> { v.iter().map(|c| (c * FREQUENCY) as f32).collect() };
+        let (xs, ys, zs) = (scaled(&sx), scaled(&sy), scaled(&sz));
+        let mut out = vec![0.0f32; SAMPLES];
+        g.bench_function("fbm6/simdnoise-avx2/scattered/samples=1024", |b| {
+            b.iter(|| {
+                simdnoise_fbm(&xs, &ys, &zs, &mut out);
+                black_box(out.iter().sum::<f32>())
+            })
+        });
+    }
     g.finish();
 }
 
