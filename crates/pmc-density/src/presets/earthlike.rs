@@ -20,7 +20,7 @@ use super::features::{
 };
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
-use crate::noise::{derive_seed, gradient3, gradient3_accumulate, Fbm, FbmParams, Ridged, RidgedParams};
+use crate::noise::{derive_seed, gradient3, Fbm, FbmParams, Ridged, RidgedParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -461,16 +461,14 @@ impl Shader for EarthShader {
         self.palette.mix_many(points, &mut mix);
         // The jitter noise at every point (`0 + 1 n`: a negative zero becomes a positive one,
         // which leaves `z` unchanged).
-        let q: Vec<DVec3> = points.iter().map(|p| self.jitter_point(*p)).collect();
-        let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
-            q.iter().map(|p| p.x).collect(),
-            q.iter().map(|p| p.y).collect(),
-            q.iter().map(|p| p.z).collect(),
-        );
-        let mut jitter = vec![0.0; points.len()];
-        gradient3_accumulate(&x, &y, &z, 1.0, self.jitter_seed, 1.0, &mut jitter);
-        // The forest noise everywhere (only compared with a positive threshold).
         let mut noise = NoiseBatch::default();
+        for p in points {
+            noise.push(self.jitter_point(*p));
+        }
+        let mut jitter = Vec::new();
+        noise.values(self.jitter_seed, &mut jitter);
+        // The forest noise everywhere (only compared with a positive threshold).
+        noise.clear();
         for d in &dirs {
             noise.push(self.forest_point(*d));
         }
