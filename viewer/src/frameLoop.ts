@@ -55,6 +55,7 @@ export class FrameLoop {
   private fpsFrames = 0;
   private fpsSince = performance.now();
   private lastUiUpdate = 0;
+  private readonly redraw = new RedrawPolicy();
 
   constructor(
     private readonly parts: FrameParts,
@@ -70,6 +71,7 @@ export class FrameLoop {
     const steps = this.steps;
     const now = performance.now();
     const dt = Math.min(0.1, Math.max(0, (now - this.lastFrame) / 1000));
+    this.redraw.frameStarted(now - this.lastFrame);
     this.lastFrame = now;
     this.frames++;
     this.fpsFrames++;
@@ -82,6 +84,7 @@ export class FrameLoop {
     const input = inputs.take();
     if (!params) {
       renderer.render(scene.scene, cameras.camera);
+      this.redraw.drew(now);
       ui.setLoading(0, 0, steps.busy() ?? 'waiting for the server');
       steps.panels(false);
       return;
@@ -109,7 +112,10 @@ export class FrameLoop {
     selection.frame(cameras.camera, viewportHeightPx, pos, basis.forward, basis.up, now, steps.busy() !== null);
     streamer.update();
 
-    renderer.render(scene.scene, cameras.camera);
+    if (this.redraw.shouldDraw(now, moved || inputActive(input), streamer.settled())) {
+      renderer.render(scene.scene, cameras.camera);
+      this.redraw.drew(now);
+    }
 
     const st = streamer.stats();
     readiness.frame(steps.busy() === null && selection.current() && streamer.settled());
@@ -137,3 +143,58 @@ export class FrameLoop {
     if (moved) steps.moved();
   }
 }
+
+/** Whether `input` asks for anything this frame (a drag, the wheel, keys, a brush press). */
+function inputActive(input: InputFrame): boolean {
+  return (
+    input.dragX !== 0 ||
+    input.dragY !== 0 ||
+    input.wheel !== 0 ||
+    input.forward !== 0 ||
+    input.right !== 0 ||
+    input.up !== 0 ||
+    input.brushPresses.length > 0 ||
+    input.brushRelease
+  );
+}
+
+/**
+ * Which frames draw. Every frame draws, except on a slow renderer (software WebGL, an old GPU:
+ * over SLOW_FRAME_MS a drawn frame) while chunks stream in under a still camera: then the picture
+ * is redrawn every STREAMING_REDRAW_MS, or once in STREAMING_DRAW_SHARE frame times when drawing
+ * takes longer. A busy GPU holds up what the page sends it (chunk uploads, the compositor's read
+ * back of the canvas) until the frame before is done, so redrawing a picture that changes by a
+ * few chunks at a time would starve the streaming (by 20 times with software WebGL on two cores).
+ * A camera that moves, or input, draws at once; a settled view draws every frame.
+ */
+export class RedrawPolicy {
+  /** Milliseconds a frame that draws takes (a running mean of the intervals after drawing). */
+  renderMs = 0;
+  private lastDraw = Number.NEGATIVE_INFINITY;
+  private drewLast = false;
+
+  /** A frame starts, `sinceLast` ms after the one before. */
+  frameStarted(sinceLast: number): void {
+    if (this.drewLast) this.renderMs = this.renderMs === 0 ? sinceLast : 0.8 * this.renderMs + 0.2 * sinceLast;
+    this.drewLast = false;
+  }
+
+  /** Whether the frame starting at `now` draws (`active`: the camera moved or input came). */
+  shouldDraw(now: number, active: boolean, settled: boolean): boolean {
+    if (active || settled || this.renderMs < SLOW_FRAME_MS) return true;
+    return now - this.lastDraw >= Math.max(STREAMING_REDRAW_MS, STREAMING_DRAW_SHARE * this.renderMs);
+  }
+
+  /** The frame starting at `now` drew. */
+  drew(now: number): void {
+    this.lastDraw = now;
+    this.drewLast = true;
+  }
+}
+
+/** A drawn frame slower than this (ms) makes a slow renderer (see `RedrawPolicy`). */
+export const SLOW_FRAME_MS = 50;
+/** How often a slow renderer redraws a still view while chunks stream in (ms)... */
+export const STREAMING_REDRAW_MS = 400;
+/** ...or at most once in this many frame times (drawing takes at most a quarter of the time). */
+export const STREAMING_DRAW_SHARE = 4;
