@@ -416,6 +416,39 @@ impl Planet {
         scratch: &mut ChunkScratch,
         out: &mut ChunkMesh,
     ) {
+        self.mesh_chunk_lod(key, coarser, scratch, out, None);
+    }
+
+    /// [`Planet::chunk_mesh_lod_into`] after one edit, reusing the shading of the vertices `op`
+    /// did not touch, as [`Planet::remesh_reusing`] does: `previous` must be the same chunk and
+    /// seam variant meshed under the edits this planet had without `op` (before `op` was pushed,
+    /// or before it was undone). The result is byte-identical to
+    /// [`Planet::chunk_mesh_lod_into`]; a `previous` of another chunk is ignored.
+    ///
+    /// # Panics
+    /// If `key` is not a chunk of the layout (check with [`Layout::contains_chunk`]).
+    pub fn chunk_mesh_lod_reusing_into(
+        &self,
+        key: ChunkKey,
+        coarser: SideMask,
+        previous: &ChunkMesh,
+        op: &BrushOp,
+        scratch: &mut ChunkScratch,
+        out: &mut ChunkMesh,
+    ) {
+        let reuse = (previous.key == Some(key)).then_some(Reuse { previous, op });
+        self.mesh_chunk_lod(key, coarser, scratch, out, reuse);
+    }
+
+    /// The level-of-detail chunk pipeline, shading from `reuse` where it can.
+    fn mesh_chunk_lod(
+        &self,
+        key: ChunkKey,
+        coarser: SideMask,
+        scratch: &mut ChunkScratch,
+        out: &mut ChunkMesh,
+        reuse: Option<Reuse>,
+    ) {
         if let Some(h) = &self.heightfield {
             h.mesh(key, coarser, out);
             self.shade(out, None);
@@ -454,7 +487,7 @@ impl Planet {
         scratch
             .mesher
             .mesh_with_transitions(&grid, &scratch.densities, &transitions, out);
-        self.shade(out, None);
+        self.shade(out, reuse.map(|r| (r, &mut scratch.previous)));
     }
 
     /// Meshes a chunk of any level with its seams closed toward coarser neighbours (allocating

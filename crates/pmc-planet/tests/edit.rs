@@ -2,11 +2,11 @@
 //! voxels, undo gives back the exact meshes, and remeshing the affected chunks is enough.
 
 use pmc_density::Density;
-use pmc_edit::{affected_chunks, BrushKind, BrushOp, EditLog, EditSnapshot};
+use pmc_edit::{affected_chunks, affected_chunks_lod, BrushKind, BrushOp, EditLog, EditSnapshot};
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{face_uv_to_sphere, ChunkGrid, ChunkKey, Face, Layout, VoxelKey};
+use pmc_geometry::{face_uv_to_sphere, ChunkGrid, ChunkKey, Face, Layout, SideMask, VoxelKey};
 use pmc_mesh::{ChunkMesh, WeldedMesh};
-use pmc_planet::{Planet, PresetKind};
+use pmc_planet::{ChunkScratch, Planet, PresetKind};
 use proptest::prelude::*;
 use std::collections::{BTreeMap, HashMap};
 
@@ -284,6 +284,48 @@ proptest! {
         // Paint is widened by one grid edge (up to 10 m here) and may change nothing (a material the
         // sphere lacks), so the slack is a few columns of chunks.
         prop_assert!(listed.len() <= changed + 24 || listed.len() <= 2 * changed + 4, "{} listed, {changed} changed", listed.len());
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+
+    /// What the server does after an edit: every chunk of every level the edit reaches, in every
+    /// seam variant, meshed reusing the shading of the same variant before the edit, gives the
+    /// bytes of meshing it anew; after a paint brush too (whose colours the reuse must not copy
+    /// inside its reach), and undoing the edit the same way.
+    #[test]
+    fn lod_chunks_reusing_the_shading_before_an_edit_are_byte_identical(
+        sphere in any::<bool>(),
+        seed in 0u64..1000,
+        first in random_op(),
+        second in random_op(),
+    ) {
+        let layout = Layout::new(4, 8, 60.0, 1.0, 2).unwrap();
+        let mut planet = Planet::new(preset(sphere), seed, layout);
+        let mut log = EditLog::new();
+        log.push(first.resolve(&planet));
+        planet.set_edits(log.snapshot());
+        let before = planet.clone();
+        let op = second.resolve(&planet);
+        log.push(op);
+        planet.set_edits(log.snapshot());
+        let mut scratch = ChunkScratch::default();
+        let mut reused = ChunkMesh::default();
+        let mut checked = 0;
+        for key in affected_chunks_lod(&layout, &op) {
+            let sides = layout.seam_sides(&key).0;
+            for mask in (0..=sides).filter(|m| m & !sides == 0).map(SideMask) {
+                for (from, to) in [(&before, &planet), (&planet, &before)] {
+                    let previous = from.chunk_mesh_lod(key, mask);
+                    let fresh = to.chunk_mesh_lod(key, mask);
+                    to.chunk_mesh_lod_reusing_into(key, mask, &previous, &op, &mut scratch, &mut reused);
+                    prop_assert!(bytes(&fresh) == bytes(&reused), "{key} seams {mask:?} after {op:?}");
+                    checked += 1;
+                }
+            }
+        }
+        prop_assert!(checked > 0);
     }
 }
 

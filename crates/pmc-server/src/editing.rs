@@ -253,7 +253,7 @@ impl Editing {
             });
         };
         let keys = affected_chunks_lod(self.base.layout(), &op);
-        let current = self.publish(&ed, generator, Some(&keys));
+        let current = self.publish(&ed, generator, Some((&keys, &op)));
         self.follow_with_nav(&current, Some(&op));
         let _ = self.events.send(EditEvent {
             event: "edit",
@@ -297,8 +297,9 @@ impl Editing {
     }
 
     /// Builds the planet of the mirror's active edits, makes it current (one revision later),
-    /// and makes the generator forget the chunks `keys` (every chunk when `None`).
-    fn publish(&self, ed: &Editor, generator: &Generator, keys: Option<&[ChunkKey]>) -> Current {
+    /// and makes the generator forget the chunks `keys` that the edit `op` changed (every chunk
+    /// when `None`).
+    fn publish(&self, ed: &Editor, generator: &Generator, keys: Option<(&[ChunkKey], &BrushOp)>) -> Current {
         let planet = Arc::new(self.base.clone().with_edits(ed.snapshot()));
         let active = ed.active();
         let current = {
@@ -314,7 +315,7 @@ impl Editing {
         // The new planet is current before the old meshes are forgotten: a job started from
         // here on meshes the edit (see `Generator::invalidate`).
         match keys {
-            Some(keys) => {
+            Some((keys, op)) => {
                 let layout = self.base.layout();
                 generator.invalidate(
                     keys.iter().flat_map(|key| {
@@ -327,6 +328,7 @@ impl Editing {
                         })
                     }),
                     current.revision,
+                    Some(op),
                 )
             }
             None => generator.invalidate_planet(self.id.clone(), current.revision),
@@ -387,7 +389,7 @@ impl Editing {
         let step = one_step(&ed.entries, &entries);
         ed.entries = entries;
         let keys = step.map(|(_, _, op)| affected_chunks_lod(self.base.layout(), &op));
-        let current = self.publish(ed, generator, keys.as_deref());
+        let current = self.publish(ed, generator, keys.as_deref().zip(step.as_ref().map(|(_, _, op)| op)));
         self.follow_with_nav(&current, step.as_ref().map(|(_, _, op)| op));
         tracing::info!(
             "{} was changed by another program: {} active edits, revision {}",

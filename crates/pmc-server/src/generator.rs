@@ -6,9 +6,16 @@
 //! the last one goes away (the client hung up, the request future was dropped) while the job
 //! still waits for a worker, the job leaves the queue at once and is never meshed. A job that a
 //! worker has started runs to the end and is cached.
+//!
+//! For the planet being edited, the meshes behind the cached chunks are kept too (in a cache of
+//! their own, bounded by bytes): when an edit changes a chunk, its mesh before the edit goes with
+//! the edit to the job that meshes the chunk again, which copies the shading of every vertex the
+//! edit did not touch instead of shading it anew ([`Planet::chunk_mesh_lod_reusing_into`]; same
+//! bytes).
 
 use crate::chunk_cache::ByteCache;
 use axum::body::Bytes;
+use pmc_edit::BrushOp;
 use pmc_formats::chunk_encoding::encode_chunk;
 use pmc_geometry::{ChunkKey, SideMask};
 use pmc_mesh::ChunkMesh;
@@ -66,6 +73,8 @@ pub(crate) struct JobCounts {
     pub dropped: u64,
     /// Requests refused because the queue was full.
     pub rejected_busy: u64,
+    /// Jobs that meshed a chunk again after an edit copying the shading of its mesh before.
+    pub reused: u64,
 }
 
 /// A job's place in the queue: higher priority first, then older first.
@@ -103,6 +112,8 @@ enum JobState {
     Queued {
         rank: Rank,
         planet: Arc<Planet>,
+        /// The edit revision of `planet`.
+        revision: u64,
         tx: watch::Sender<Option<JobResult>>,
     },
     /// A worker is generating it.
@@ -133,6 +144,8 @@ struct Store {
     changed_at: HashMap<ChunkId, u64>,
     /// For each planet a change may have touched everywhere: the planet revision of that change.
     min_revision: HashMap<PlanetId, u64>,
+    /// The meshes of the edited planet's cached chunks (see [`Reuse`]).
+    meshes: Option<Reuse>,
     next_token: u64,
     /// The counters (`queued` and `waiting` are counted when a snapshot is taken).
     counts: JobCounts,
@@ -167,6 +180,25 @@ impl Store {
     }
 }
 
+/// What the generator keeps so that meshing a chunk again after an edit can copy the shading of
+/// the vertices the edit did not touch.
+struct Reuse {
+    /// The planet being edited (meshes of other planets are not kept).
+    planet: PlanetId,
+    /// The meshes behind its cached chunks, of the revision the cache is of.
+    meshes: ByteCache<ChunkId, Arc<ChunkMesh>>,
+    /// For each chunk an edit changed and no job has meshed since: its mesh before the edit,
+    /// the edit, and the revision the edit made (a job of that revision may reuse the mesh).
+    /// Bounded like `meshes`: chunks edited and never asked for again do not pile up.
+    previous: ByteCache<ChunkId, (Arc<ChunkMesh>, BrushOp, u64)>,
+}
+
+/// Bytes a mesh holds (its buffers), for the mesh cache's bound.
+fn mesh_bytes(m: &ChunkMesh) -> u64 {
+    let per_vertex = 12 + 12 + std::mem::size_of::<pmc_geometry::EdgeKey>() + 4 + 4 + 4 + 1;
+    (m.vertex_count() * per_vertex + m.indices.len() * 4 + 64) as u64
+}
+
 /// Generates, de-duplicates and caches encoded chunks.
 pub(crate) struct Generator {
     store: Mutex<Store>,
@@ -191,19 +223,37 @@ thread_local! {
     static SCRATCH: RefCell<ChunkScratch> = RefCell::new(ChunkScratch::default());
 }
 
-/// Meshes and encodes one chunk (on a worker thread).
-fn generate(planet: &Planet, key: ChunkKey, seams: SideMask) -> Result<Bytes, String> {
+/// Meshes and encodes one chunk (on a worker thread), reusing the shading of `previous` (the
+/// chunk's mesh before the edit given with it) where the edit did not reach.
+fn generate(
+    planet: &Planet,
+    key: ChunkKey,
+    seams: SideMask,
+    previous: Option<&(Arc<ChunkMesh>, BrushOp)>,
+) -> Result<(Bytes, ChunkMesh), String> {
     let mut mesh = ChunkMesh::default();
-    SCRATCH.with(|s| planet.chunk_mesh_lod_into(key, seams, &mut s.borrow_mut(), &mut mesh));
+    SCRATCH.with(|s| {
+        let scratch = &mut s.borrow_mut();
+        match previous {
+            Some((previous, op)) => planet.chunk_mesh_lod_reusing_into(key, seams, previous, op, scratch, &mut mesh),
+            None => planet.chunk_mesh_lod_into(key, seams, scratch, &mut mesh),
+        }
+    });
     let mut out = Vec::new();
     encode_chunk(&mesh, &mut out).map_err(|e| e.to_string())?;
-    Ok(Bytes::from(out))
+    Ok((Bytes::from(out), mesh))
 }
 
 impl Generator {
     /// A generator with `threads` workers (0: one per core), at most `queue_limit` waiting jobs
-    /// and `cache_bytes` of cache.
-    pub fn new(threads: usize, queue_limit: usize, cache_bytes: u64) -> Result<Generator, String> {
+    /// and `cache_bytes` of cache; with `edited`, the planet being edited and the bytes of its
+    /// meshes kept for reusing their shading after an edit.
+    pub fn new(
+        threads: usize,
+        queue_limit: usize,
+        cache_bytes: u64,
+        edited: Option<(PlanetId, u64)>,
+    ) -> Result<Generator, String> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("pmc-chunk-{i}"))
@@ -217,6 +267,11 @@ impl Generator {
                 queue: BTreeMap::new(),
                 changed_at: HashMap::new(),
                 min_revision: HashMap::new(),
+                meshes: edited.map(|(planet, bytes)| Reuse {
+                    planet,
+                    meshes: ByteCache::new(bytes),
+                    previous: ByteCache::new(bytes),
+                }),
                 next_token: 0,
                 counts: JobCounts::default(),
             }),
@@ -279,7 +334,12 @@ impl Generator {
                             id: id.clone(),
                             rx: rx.clone(),
                             waiters: 1,
-                            state: JobState::Queued { rank, planet, tx },
+                            state: JobState::Queued {
+                                rank,
+                                planet,
+                                revision,
+                                tx,
+                            },
                         },
                     );
                     store.pending.insert(id, token);
@@ -331,11 +391,30 @@ impl Generator {
     /// queued or running for them (their waiters still get their answer, but it is not cached),
     /// and makes planets older than `revision` unable to start jobs for them. Call it after the
     /// edited planet replaced the old one, before telling clients.
-    pub fn invalidate(&self, ids: impl IntoIterator<Item = ChunkId>, revision: u64) {
-        let mut store = self.store();
+    ///
+    /// With the edit `op` that made `revision` (applied, undone or redone), the meshes of `ids`
+    /// kept for the edited planet go to the jobs of `revision` that mesh them again, for their
+    /// shading.
+    pub fn invalidate(&self, ids: impl IntoIterator<Item = ChunkId>, revision: u64, op: Option<&BrushOp>) {
+        let mut guard = self.store();
+        let store = &mut *guard;
         for id in ids {
             store.cache.remove(&id);
             store.pending.remove(&id);
+            if let Some(reuse) = &mut store.meshes {
+                // A mesh from before an earlier edit that no job has replaced is no longer the
+                // mesh before this one.
+                let before = reuse.meshes.remove(&id);
+                match (before, op) {
+                    (Some(mesh), Some(op)) => {
+                        let size = mesh_bytes(&mesh);
+                        reuse.previous.insert(id.clone(), (mesh, *op, revision), size);
+                    }
+                    _ => {
+                        reuse.previous.remove(&id);
+                    }
+                }
+            }
             let at = store.changed_at.entry(id).or_insert(revision);
             *at = (*at).max(revision);
         }
@@ -344,39 +423,64 @@ impl Generator {
     /// One worker task: takes the best queued job, if any is left, and runs it: generate, cache,
     /// wake the waiters.
     fn work(&self) {
-        let (token, id, planet, tx) = {
-            let mut store = self.store();
+        let (token, id, planet, previous, tx) = {
+            let mut guard = self.store();
+            let store = &mut *guard;
             let Some((_, token)) = store.queue.pop_first() else {
                 return;
             };
             let Some(job) = store.jobs.get_mut(&token) else {
                 return;
             };
-            let (planet, tx) = match std::mem::replace(&mut job.state, JobState::Running) {
-                JobState::Queued { planet, tx, .. } => (planet, tx),
+            let (planet, revision, tx) = match std::mem::replace(&mut job.state, JobState::Running) {
+                JobState::Queued {
+                    planet, revision, tx, ..
+                } => (planet, revision, tx),
                 JobState::Running => return,
             };
             let id = job.id.clone();
+            // The mesh before the edit of this job's revision, when it is kept.
+            let previous = store.meshes.as_ref().and_then(|r| {
+                r.previous
+                    .get(&id)
+                    .filter(|(_, _, at)| *at == revision)
+                    .map(|(mesh, op, _)| (Arc::clone(mesh), *op))
+            });
             store.counts.running += 1;
-            (token, id, planet, tx)
+            store.counts.reused += u64::from(previous.is_some());
+            (token, id, planet, previous, tx)
         };
-        let result: JobResult =
-            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| generate(&planet, id.key, id.seams))) {
-                Ok(Ok(bytes)) => Ok(bytes),
-                Ok(Err(e)) => Err(format!("chunk {} could not be encoded: {e}", id.key).into()),
-                Err(_) => Err(format!("generating chunk {} panicked; this is a bug in pmc", id.key).into()),
-            };
+        let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            generate(&planet, id.key, id.seams, previous.as_ref())
+        }));
+        let (result, mesh): (JobResult, Option<ChunkMesh>) = match generated {
+            Ok(Ok((bytes, mesh))) => (Ok(bytes), Some(mesh)),
+            Ok(Err(e)) => (Err(format!("chunk {} could not be encoded: {e}", id.key).into()), None),
+            Err(_) => (
+                Err(format!("generating chunk {} panicked; this is a bug in pmc", id.key).into()),
+                None,
+            ),
+        };
         {
             // Cache and un-register under one lock, so a new request sees one or the other; a
             // job that an edit invalidated meanwhile (it is no longer the registered one) is not
             // cached.
-            let mut store = self.store();
+            let mut guard = self.store();
+            let store = &mut *guard;
             store.counts.running = store.counts.running.saturating_sub(1);
             store.counts.done += 1;
             if let Ok(bytes) = &result {
                 store.counts.generated += 1;
                 if store.pending.get(&id) == Some(&token) {
                     store.cache.insert(id.clone(), bytes.clone(), bytes.len() as u64);
+                    if let (Some(reuse), Some(mesh)) = (&mut store.meshes, mesh) {
+                        if reuse.planet == id.planet {
+                            // The chunk is current again: this mesh is the one before its next edit.
+                            reuse.previous.remove(&id);
+                            let size = mesh_bytes(&mesh);
+                            reuse.meshes.insert(id.clone(), Arc::new(mesh), size);
+                        }
+                    }
                 }
             }
             store.unregister(id, token);
@@ -387,7 +491,12 @@ impl Generator {
 
     /// Drops the cached chunks of `planet`.
     pub fn forget_planet(&self, planet: PlanetId) {
-        self.store().cache.retain(|id| id.planet != planet);
+        let mut store = self.store();
+        store.cache.retain(|id| id.planet != planet);
+        if let Some(reuse) = &mut store.meshes {
+            reuse.meshes.retain(|id| id.planet != planet);
+            reuse.previous.retain(|id| id.planet != planet);
+        }
     }
 
     /// Forgets every cached chunk and queued or running job of `planet` and makes planets older
@@ -395,6 +504,10 @@ impl Generator {
     pub fn invalidate_planet(&self, planet: PlanetId, revision: u64) {
         let mut store = self.store();
         store.cache.retain(|id| id.planet != planet);
+        if let Some(reuse) = &mut store.meshes {
+            reuse.meshes.retain(|id| id.planet != planet);
+            reuse.previous.retain(|id| id.planet != planet);
+        }
         store.pending.retain(|id, _| id.planet != planet);
         store.changed_at.retain(|id, _| id.planet != planet);
         store.min_revision.insert(planet, revision);

@@ -6,7 +6,7 @@ mod common;
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use axum::Router;
-use common::{get, send, small_config, small_layout, Reply};
+use common::{get, send, small_config, small_layout, stats, Reply};
 use futures_util::StreamExt;
 use pmc_edit::{affected_chunks_lod, BrushKind, BrushOp};
 use pmc_formats::chunk_encoding::encode_chunk;
@@ -208,6 +208,14 @@ async fn edits_change_exactly_the_listed_chunks_and_undo_redo_restore_them() {
         }
     }
     assert!(changed_coarse > 0, "the edit changed some coarser chunk");
+    // The listed chunks were meshed again from their meshes before the edit (the shading of the
+    // vertices the edit did not reach copied), with the bytes of a fresh mesh checked above.
+    let reused = |s: Value| s["jobs"]["reused_shading"].as_u64().unwrap();
+    let after_edit = reused(stats(&a).await);
+    assert!(
+        after_edit >= changed as u64,
+        "{after_edit} chunks reused their shading, {changed} changed"
+    );
 
     // The edit is in the file, durably.
     let w = World::open(&path).unwrap();
@@ -226,6 +234,8 @@ async fn edits_change_exactly_the_listed_chunks_and_undo_redo_restore_them() {
             encoded(&base, *k).as_slice()
         );
     }
+    let after_undo = reused(stats(&a).await);
+    assert!(after_undo > after_edit, "undoing reuses the edited meshes' shading too");
     let v = post_empty(&a, "/api/v1/edits/undo").await.json();
     assert_eq!(
         (v["id"].clone(), v["chunks"].clone()),
@@ -240,6 +250,7 @@ async fn edits_change_exactly_the_listed_chunks_and_undo_redo_restore_them() {
             encoded(&edited, *k).as_slice()
         );
     }
+    assert!(reused(stats(&a).await) > after_undo, "and redoing");
     let list = get(&a, "/api/v1/edits").await.json();
     assert_eq!(list["active"], 1);
     assert_eq!(list["edits"][0]["brush"], "remove");
