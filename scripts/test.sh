@@ -34,19 +34,19 @@ cargo fmt --all -- --check
 step "cargo clippy (warnings denied)"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 
-step "cargo test"
 mkdir -p target
-cargo test --workspace --locked 2>&1 | tee target/cargo-test.log
-
 step "viewer: type check and unit tests (vitest)"
 (cd viewer && npx tsc --noEmit && npm test 2>&1) | tee target/vitest.log
 
-step "viewer: build (embedded into pmc)"
+step "viewer: build (embedded into pmc by the next step)"
 (cd viewer && npm run --silent build)
 
-step "build pmc (release)"
-cargo build --release --locked --bin pmc
-PMC=target/release/pmc
+step "cargo test"
+cargo test --workspace --locked 2>&1 | tee target/cargo-test.log
+# The pmc binary the CLI's tests ran, built by `cargo test` with the test profile (optimised,
+# viewer/dist embedded): the exports and the end-to-end tests below use it too, so the suite
+# compiles the workspace once, not a second time for a release build.
+PMC=target/debug/pmc
 
 OUT=target/test-artifacts
 mkdir -p "$OUT"
