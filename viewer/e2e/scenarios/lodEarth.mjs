@@ -26,7 +26,6 @@ export async function scenario(t) {
       { name: 'orbit', height: 12_000_000, orbit: true },
       { name: '2m', height: 2 },
     ],
-    pictures: true,
     // 6.4e6 m to two figures: the camera is 6 367 551 m from the centre
     jitter: 6.36e6,
   });
