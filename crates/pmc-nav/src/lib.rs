@@ -36,6 +36,7 @@ mod lazy;
 mod report;
 mod rules;
 mod search;
+mod smooth;
 
 pub use agent::{Agent, AgentError};
 pub use columns::{ColumnPlace, Columns, NeighbourPlaces, Neighbours};
@@ -46,6 +47,7 @@ pub use report::{
     PATH_VERSION,
 };
 pub use search::{find_path, NoPath, Path, SearchOptions, SearchStats};
+pub use smooth::{smooth_path, SmoothPath};
 
 /// Layouts with more column slots than this (`6 (N + 1)^2`; `n_c n_t` above about 800) are
 /// navigated with the [`LazyGrid`]: a whole-planet [`NavGrid`] of them would take too long to
