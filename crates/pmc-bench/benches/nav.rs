@@ -15,7 +15,10 @@ use pmc_density::Density;
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{LatLon, Layout};
-use pmc_nav::{find_path, Agent, End, LazyGrid, LazyOptions, NavGrid, PathAnswer, SearchOptions};
+use pmc_nav::{
+    find_path, find_path_hierarchical, smooth_path, Agent, End, LazyGrid, LazyOptions, NavGrid, PathAnswer,
+    SearchOptions,
+};
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Duration;
@@ -76,8 +79,28 @@ fn nav(c: &mut Criterion) {
             path.nodes.len() - 1,
             path.expanded
         );
+        let fast = find_path_hierarchical(&grid, from, to).expect("a path");
+        let smooth = smooth_path(&grid, &fast);
+        let (pa, pb) = (grid.position(from).expect("a node"), grid.position(to).expect("a node"));
+        eprintln!(
+            "{name} hierarchical: {:.0} m ({:.4} of the exact), {} steps, {} nodes expanded; smoothed {:.0} m in {} legs ({:.4} of the great circle at the ends' mean radius, {:.0} m)",
+            fast.length,
+            fast.length / path.length,
+            fast.nodes.len() - 1,
+            fast.expanded,
+            smooth.length,
+            smooth.corners.len() - 1,
+            smooth.length / (pa.angle_between(pb) * 0.5 * (pa.length() + pb.length())),
+            pa.angle_between(pb) * 0.5 * (pa.length() + pb.length()),
+        );
         g.bench_function(format!("astar/{name}"), |bch| {
             bch.iter(|| black_box(find_path(&grid, from, to)))
+        });
+        g.bench_function(format!("hierarchical/{name}"), |bch| {
+            bch.iter(|| black_box(find_path_hierarchical(&grid, from, to)))
+        });
+        g.bench_function(format!("hierarchical_smoothed/{name}"), |bch| {
+            bch.iter(|| black_box(find_path_hierarchical(&grid, from, to).map(|p| smooth_path(&grid, &p))))
         });
     }
     g.finish();

@@ -32,6 +32,7 @@
 mod agent;
 mod columns;
 mod grid;
+mod hierarchical;
 mod lazy;
 mod report;
 mod rules;
@@ -41,6 +42,7 @@ mod smooth;
 pub use agent::{Agent, AgentError};
 pub use columns::{ColumnPlace, Columns, NeighbourPlaces, Neighbours};
 pub use grid::{NavError, NavGrid, Node, NodeId, Step, TileKey, MAX_COLUMNS};
+pub use hierarchical::{find_path_hierarchical, HIERARCHICAL_WEIGHT};
 pub use lazy::{CacheStats, LazyAnswer, LazyGrid, LazyOptions, NodeKey};
 pub use report::{
     lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, waypoint, End, PathAnswer, PATH_FORMAT,

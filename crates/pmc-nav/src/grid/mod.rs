@@ -22,16 +22,20 @@
 //!   touches are sampled again ([`NavGrid::rebuild_for`]).
 //! - **Components** label the nodes joined by steps (either way), so detached grids (Fig. 10) are
 //!   known without a search: nodes in different components have no path between them.
+//! - **The abstract graph** of the hierarchical search ([`crate::find_path_hierarchical`]): a
+//!   node per (tile, local component) pair, a link per pair of pairs that a border step joins;
+//!   kept up to date by every rebuild, like the components.
 //!
 //! The grid holds every column of the planet, up to [`MAX_COLUMNS`]. [`crate::LazyGrid`] has the
 //! same floors and steps (the rules are one implementation) for planets of any size, built tile
 //! by tile around a query, without components.
 //!
 //! This module holds the types and the build and rebuild by tile; `occupancy` samples a tile's
-//! voxels and floors, `components` labels the components, and `queries` answers for nodes,
+//! voxels and floors, `components` labels the components, `hierarchy` keeps the abstract graph, and `queries` answers for nodes,
 //! steps and the nodes near a place.
 
 mod components;
+mod hierarchy;
 mod occupancy;
 mod queries;
 
@@ -40,6 +44,7 @@ use crate::columns::{ColumnPlace, Columns};
 use crate::rules::Rules;
 use pmc_density::Density;
 use pmc_edit::{affected_chunks, BrushOp};
+use pmc_geometry::glam::DVec3;
 use pmc_geometry::{Face, Layout};
 use rayon::prelude::*;
 
@@ -85,12 +90,21 @@ struct Tile {
     local_sizes: Vec<u32>,
     /// Steps that leave the tile.
     border: Vec<BorderStep>,
+    /// Mean surface point of each local component (the abstract graph's nodes).
+    local_points: Vec<DVec3>,
+    /// Links of the abstract graph out of the tile: (local component, tile, local component
+    /// there), sorted, each once.
+    links: Vec<Link>,
     /// Smallest radius of its nodes' surface points (infinite without nodes).
     min_radius: f64,
 }
 
 /// A step out of a tile: (local node, tile index, local node there).
 type BorderStep = (u32, u32, u32);
+
+/// A link of the abstract graph out of a tile: (local component, tile index, local component
+/// there).
+type Link = (u32, u32, u32);
 
 /// Why a grid could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -264,16 +278,19 @@ impl NavGrid {
         self.tile_base = base;
         self.min_radius = self.tiles.iter().map(|t| t.min_radius).fold(f64::INFINITY, f64::min);
         // Steps inside the rebuilt tiles.
-        let inside: Vec<(usize, Vec<u32>, Vec<u32>)> = rebuilt
+        type Inside = (usize, Vec<u32>, Vec<u32>, Vec<DVec3>);
+        let inside: Vec<Inside> = rebuilt
             .par_iter()
             .map(|t| {
                 let (local, sizes) = self.inner_components(*t);
-                (*t, local, sizes)
+                let points = self.local_points(*t, &local, &sizes);
+                (*t, local, sizes, points)
             })
             .collect();
-        for (t, local, sizes) in inside {
+        for (t, local, sizes, points) in inside {
             self.tiles[t].local = local;
             self.tiles[t].local_sizes = sizes;
+            self.tiles[t].local_points = points;
         }
         // Steps across borders: of the rebuilt tiles and of every tile next to one.
         let mut touched: Vec<usize> = rebuilt.clone();
@@ -285,6 +302,11 @@ impl NavGrid {
         let borders: Vec<(usize, Vec<BorderStep>)> = touched.par_iter().map(|t| (*t, self.border_steps(*t))).collect();
         for (t, border) in borders {
             self.tiles[t].border = border;
+        }
+        // The abstract graph's links, from those border steps.
+        let links: Vec<(usize, Vec<Link>)> = touched.par_iter().map(|t| (*t, self.links(*t))).collect();
+        for (t, l) in links {
+            self.tiles[t].links = l;
         }
         self.merge_components();
     }
