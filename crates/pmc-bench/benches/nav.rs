@@ -46,6 +46,13 @@ fn nav(c: &mut Criterion) {
     g.bench_function("rebuild/one_tile", |b| {
         b.iter(|| work.rebuild_tiles(density.as_ref(), black_box(&[tile])))
     });
+    // The same tile read from the planet's base cache (warm: its chunks were meshed or read
+    // before, as the chunks around a user editing always are).
+    let cached = default_planet().with_base_cache(64);
+    work.rebuild_tiles_from(&cached, &[tile]);
+    g.bench_function("rebuild/one_tile/base_cache", |b| {
+        b.iter(|| work.rebuild_tiles_from(&cached, black_box(&[tile])))
+    });
     // The 4 m brush on the nearest voxel column (between columns it changes no sample), as in
     // the edit benchmark.
     let at = surface_point(&planet, 20.0, 30.0);
@@ -57,6 +64,12 @@ fn nav(c: &mut Criterion) {
         g.bench_function(
             format!("rebuild/after_{name}/tiles={}", work.tiles_for(&op).len()),
             |b| b.iter(|| black_box(work.rebuild_for(&edited, black_box(&op)))),
+        );
+        let cached_edited = cached.clone().with_edits(EditSnapshot::from(vec![op]));
+        work.rebuild_for_from(&cached_edited, &op);
+        g.bench_function(
+            format!("rebuild/after_{name}/tiles={}/base_cache", work.tiles_for(&op).len()),
+            |b| b.iter(|| black_box(work.rebuild_for_from(&cached_edited, black_box(&op)))),
         );
     }
     // Corner to corner of the Top face (about 4.4 km of walking), and a walk of about 500 m.

@@ -91,7 +91,9 @@ proptest! {
         let (pa, pb) = (g.position(from).unwrap(), g.position(to).unwrap());
         let best = pa.angle_between(pb) * 0.5 * (pa.length() + pb.length());
         prop_assert!(s.length <= 1.05 * best + 1e-9, "{} vs {best} ({} corners)", s.length, s.corners.len());
-        prop_assert!(s.length <= path.length + 1e-9);
+        // Legs are arcs where steps cost chords: on a straight walk along the grid the smoothed
+        // length is the grid walk's, plus a few parts in 10^5.
+        prop_assert!(s.length <= path.length * 1.0001, "{} vs {}", s.length, path.length);
         prop_assert_eq!(s.corners.first(), Some(&from));
         prop_assert_eq!(s.corners.last(), Some(&to));
         assert_walkable(g, &s, 8.0);

@@ -10,7 +10,7 @@
 //! way when the agent's drops are deeper than its climbs), which the search handles by falling
 //! back to the exact search.
 
-use super::{Link, NavGrid, NodeId};
+use super::{BorderStep, Link, NavGrid, NodeId};
 use pmc_geometry::glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -37,30 +37,11 @@ impl PartialOrd for Open {
 }
 
 impl NavGrid {
-    /// The mean surface point of each local component of tile `t` (labels of `local`, sizes
-    /// `sizes`).
-    pub(super) fn local_points(&self, t: usize, local: &[u32], sizes: &[u32]) -> Vec<DVec3> {
-        let tile = &self.tiles[t];
-        let mut sums = vec![DVec3::ZERO; sizes.len()];
-        for (lc, column) in tile.columns.iter().enumerate() {
-            let dir = self.columns.direction(*column);
-            for i in tile.starts[lc]..tile.starts[lc + 1] {
-                let i = i as usize;
-                sums[local[i] as usize] += dir * tile.nodes[i].radius;
-            }
-        }
-        sums.iter()
-            .zip(sizes)
-            .map(|(s, n)| *s / f64::from((*n).max(1)))
-            .collect()
-    }
-
-    /// The links out of tile `t`, from its border steps: (local component, tile, local
+    /// The links out of tile `t` from its border steps `border`: (local component, tile, local
     /// component there), sorted, each once.
-    pub(super) fn links(&self, t: usize) -> Vec<Link> {
+    pub(super) fn links(&self, t: usize, border: &[BorderStep]) -> Vec<Link> {
         let tile = &self.tiles[t];
-        let mut out: Vec<Link> = tile
-            .border
+        let mut out: Vec<Link> = border
             .iter()
             .map(|(from, u, to)| {
                 (
