@@ -15,7 +15,10 @@ use pmc_density::Density;
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{LatLon, Layout};
-use pmc_nav::{find_path, Agent, End, LazyGrid, LazyOptions, NavGrid, PathAnswer, SearchOptions};
+use pmc_nav::{
+    find_path, find_path_hierarchical, smooth_path, Agent, End, LazyGrid, LazyOptions, NavGrid, PathAnswer,
+    SearchOptions,
+};
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Duration;
@@ -43,6 +46,13 @@ fn nav(c: &mut Criterion) {
     g.bench_function("rebuild/one_tile", |b| {
         b.iter(|| work.rebuild_tiles(density.as_ref(), black_box(&[tile])))
     });
+    // The same tile read from the planet's base cache (warm: its chunks were meshed or read
+    // before, as the chunks around a user editing always are).
+    let cached = default_planet().with_base_cache(64);
+    work.rebuild_tiles_from(&cached, &[tile]);
+    g.bench_function("rebuild/one_tile/base_cache", |b| {
+        b.iter(|| work.rebuild_tiles_from(&cached, black_box(&[tile])))
+    });
     // The 4 m brush on the nearest voxel column (between columns it changes no sample), as in
     // the edit benchmark.
     let at = surface_point(&planet, 20.0, 30.0);
@@ -54,6 +64,12 @@ fn nav(c: &mut Criterion) {
         g.bench_function(
             format!("rebuild/after_{name}/tiles={}", work.tiles_for(&op).len()),
             |b| b.iter(|| black_box(work.rebuild_for(&edited, black_box(&op)))),
+        );
+        let cached_edited = cached.clone().with_edits(EditSnapshot::from(vec![op]));
+        work.rebuild_for_from(&cached_edited, &op);
+        g.bench_function(
+            format!("rebuild/after_{name}/tiles={}/base_cache", work.tiles_for(&op).len()),
+            |b| b.iter(|| black_box(work.rebuild_for_from(&cached_edited, black_box(&op)))),
         );
     }
     // Corner to corner of the Top face (about 4.4 km of walking), and a walk of about 500 m.
@@ -76,8 +92,28 @@ fn nav(c: &mut Criterion) {
             path.nodes.len() - 1,
             path.expanded
         );
+        let fast = find_path_hierarchical(&grid, from, to).expect("a path");
+        let smooth = smooth_path(&grid, &fast);
+        let (pa, pb) = (grid.position(from).expect("a node"), grid.position(to).expect("a node"));
+        eprintln!(
+            "{name} hierarchical: {:.0} m ({:.4} of the exact), {} steps, {} nodes expanded; smoothed {:.0} m in {} legs ({:.4} of the great circle at the ends' mean radius, {:.0} m)",
+            fast.length,
+            fast.length / path.length,
+            fast.nodes.len() - 1,
+            fast.expanded,
+            smooth.length,
+            smooth.corners.len() - 1,
+            smooth.length / (pa.angle_between(pb) * 0.5 * (pa.length() + pb.length())),
+            pa.angle_between(pb) * 0.5 * (pa.length() + pb.length()),
+        );
         g.bench_function(format!("astar/{name}"), |bch| {
             bch.iter(|| black_box(find_path(&grid, from, to)))
+        });
+        g.bench_function(format!("hierarchical/{name}"), |bch| {
+            bch.iter(|| black_box(find_path_hierarchical(&grid, from, to)))
+        });
+        g.bench_function(format!("hierarchical_smoothed/{name}"), |bch| {
+            bch.iter(|| black_box(find_path_hierarchical(&grid, from, to).map(|p| smooth_path(&grid, &p))))
         });
     }
     g.finish();

@@ -1,8 +1,9 @@
 //! `pmc path`: the walking path between two places on a planet (or a world's edited planet), over
 //! its navigation grid, as JSON or GeoJSON (docs/specs/path-v1.md).
 //!
-//! Planets of up to [`pmc_nav::EAGER_COLUMNS`] columns get the whole-planet grid (components known, every
-//! path a shortest one); larger ones, the Earth at true scale among them, get the lazy grid, built
+//! Planets of up to [`pmc_nav::EAGER_COLUMNS`] columns get the whole-planet grid (components known, the
+//! walk from the hierarchical search, within [`pmc_nav::HIERARCHICAL_WEIGHT`] of the shortest, with
+//! its smoothed form); larger ones, the Earth at true scale among them, get the lazy grid, built
 //! tile by tile around the search within its bounds (`--max-expanded`, `--max-tiles`, `--weight`).
 
 use crate::edit::parse_place;
@@ -11,8 +12,8 @@ use crate::planet_args::PlanetArgs;
 use clap::{Args, ValueEnum};
 use pmc_geometry::{LatLon, Place};
 use pmc_nav::{
-    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, wants_lazy_grid, Agent, End, LazyGrid,
-    LazyOptions, NavGrid, PathAnswer, SearchOptions,
+    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, query_exact, wants_lazy_grid, Agent, End,
+    LazyGrid, LazyOptions, NavGrid, PathAnswer, SearchOptions,
 };
 use std::io::Write;
 use std::path::PathBuf;
@@ -79,6 +80,11 @@ pub struct PathArgs {
     /// used anyway above 4 million columns).
     #[arg(long)]
     lazy: bool,
+
+    /// Whole-planet grid: the exact shortest walk (A* over the whole grid) instead of the
+    /// hierarchical search's (within 1.5 times the shortest, far faster across long distances).
+    #[arg(long)]
+    exact: bool,
 
     /// Lazy grid: most nodes the search expands before it answers "no path found within the
     /// search bound".
@@ -177,7 +183,11 @@ pub fn run(args: &PathArgs) -> Result<(), CliError> {
                 start.elapsed().as_secs_f64() * 1e3
             );
         }
-        let answer = query(&grid, a, b, SNAP_RINGS);
+        let answer = if args.exact {
+            query_exact(&grid, a, b, SNAP_RINGS)
+        } else {
+            query(&grid, a, b, SNAP_RINGS)
+        };
         if !args.quiet {
             report(&answer);
         }

@@ -305,7 +305,16 @@ fn the_search_bound_is_an_answer_of_its_own() {
 fn a_small_planet_gives_the_same_walk_on_either_grid() {
     let mut args = vec!["path", "--from", "10,10", "--to", "12,40", "--quiet", "--weight", "1"];
     args.extend(SMALL);
-    let whole = json_out(&args);
+    let mut exact = args.clone();
+    exact.push("--exact");
+    let whole = json_out(&exact);
+    // The hierarchical search's walk is no shorter, and within its weight.
+    let fast = json_out(&args)["length"].as_f64().unwrap();
+    let shortest = whole["length"].as_f64().unwrap();
+    assert!(
+        fast >= shortest - 1e-9 && fast <= 1.5 * shortest,
+        "{fast} vs {shortest}"
+    );
     args.push("--lazy");
     let lazy = json_out(&args);
     assert_eq!(

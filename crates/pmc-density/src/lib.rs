@@ -10,9 +10,11 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+mod chunk_samples;
 mod density;
 pub mod noise;
 pub mod presets;
 pub mod terrain;
 
+pub use chunk_samples::ChunkSamples;
 pub use density::{Density, FnDensity, Sphere, Subtract, Union};

@@ -109,6 +109,32 @@ impl ChunkGrid {
         }
     }
 
+    /// The grid of the chunk `k` deep under the same footprint (same face, level, `i` and `j`):
+    /// the same columns, their directions copied rather than computed again, and that chunk's
+    /// layers. The same as [`ChunkGrid::new`] for that chunk, field for field.
+    ///
+    /// # Panics
+    /// If that chunk is not part of `layout`.
+    pub fn at_depth(&self, layout: &Layout, k: u32) -> ChunkGrid {
+        let key = ChunkKey { k, ..self.key };
+        assert!(layout.contains_chunk(&key), "chunk {key} is not part of the layout");
+        let k0 = i64::from(k) * self.tiles as i64 * self.stride;
+        let radii: Vec<f64> = (0..self.padded)
+            .map(|c| layout.layer_radius(k0 + (c as i64 - 1) * self.stride))
+            .collect();
+        let mid = self.padded / 2;
+        ChunkGrid {
+            key,
+            k0,
+            origin: self.dirs[mid * self.padded + mid] * radii[mid],
+            radii,
+            dirs: self.dirs.clone(),
+            lattice: self.lattice.clone(),
+            valid: self.valid.clone(),
+            ..*self
+        }
+    }
+
     /// Number of padded samples, `padded^3`.
     pub fn sample_count(&self) -> usize {
         self.padded * self.padded * self.padded
@@ -144,6 +170,25 @@ impl ChunkGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_grid_at_another_depth_is_the_grid_of_that_chunk() {
+        let l = Layout::new(2, 4, 30.0, 1.0, 3).unwrap();
+        for key in l.chunks(0).into_iter().chain(l.chunks(1)) {
+            let top = ChunkGrid::new(&l, ChunkKey { k: 0, ..key });
+            let (a, b) = (top.at_depth(&l, key.k), ChunkGrid::new(&l, key));
+            assert_eq!(a.key, b.key);
+            assert_eq!(
+                (a.tiles, a.padded, a.stride, a.i0, a.j0, a.k0),
+                (b.tiles, b.padded, b.stride, b.i0, b.j0, b.k0)
+            );
+            assert_eq!(
+                (a.dirs, a.lattice, a.valid, a.radii),
+                (b.dirs, b.lattice, b.valid, b.radii)
+            );
+            assert_eq!(a.origin, b.origin);
+        }
+    }
 
     #[test]
     fn neighbouring_chunks_share_border_voxels_bit_for_bit() {

@@ -296,6 +296,13 @@ pub struct Neighbours {
     len: usize,
 }
 
+impl Neighbours {
+    /// Four neighbours.
+    pub(crate) fn of(list: [u32; 4]) -> Neighbours {
+        Neighbours { list, len: 4 }
+    }
+}
+
 impl std::ops::Deref for Neighbours {
     type Target = [u32];
     fn deref(&self) -> &[u32] {

@@ -8,7 +8,16 @@
 //! - [`NavGrid`]: surface voxels (every floor of a column, so cave floors too), the steps an
 //!   [`Agent`] can take between them, and components; rebuilt per tile after an edit. Up to
 //!   [`MAX_COLUMNS`] columns.
-//! - [`find_path`]: the shortest walk between two nodes, or [`NoPath`] (an answer, not an error).
+//! - [`find_path`]: the shortest walk between two nodes, or [`NoPath`] (an answer, not an error):
+//!   the exact reference.
+//! - [`find_path_hierarchical`]: the same answer on whether a walk exists, the walk found through
+//!   an abstract graph of the tiles' local components and a weighted A* in the corridor it picks
+//!   (within [`HIERARCHICAL_WEIGHT`] of the shortest there; tens of times faster across a face).
+//! - [`smooth_path`]: a walk pulled into straight legs along great circles, each leg checked
+//!   column by column against the grid's own steps ([`SmoothPath`]).
+//! - Rebuilds after an edit read either the density or whole-chunk batches
+//!   ([`NavGrid::rebuild_for_from`] with a `pmc_density::ChunkSamples`, which a planet with a base
+//!   cache answers without sampling its terrain again).
 //! - [`LazyGrid`]: the same nodes and steps, built on first use in small tiles kept in a cache
 //!   bounded in bytes, sampling only a band of layers around each column's top on deep shells
 //!   (the Earth at 1 m voxels); searched within [`SearchOptions`] bounds, answering "no path
@@ -17,7 +26,7 @@
 //! ```
 //! use pmc_density::Sphere;
 //! use pmc_geometry::{glam::DVec3, Layout};
-//! use pmc_nav::{find_path, Agent, NavGrid};
+//! use pmc_nav::{find_path, find_path_hierarchical, smooth_path, Agent, NavGrid, HIERARCHICAL_WEIGHT};
 //! let layout = Layout::new(2, 8, 100.0, 2.0, 1).unwrap();
 //! let grid = NavGrid::build(&Sphere { radius: 110.0 }, &layout, Agent::default()).unwrap();
 //! let a = grid.node_near(DVec3::Y, None, 0).unwrap();
@@ -25,6 +34,12 @@
 //! let path = find_path(&grid, a, b).unwrap();
 //! // A quarter of a great circle at radius about 110 m.
 //! assert!((path.length - 110.0 * std::f64::consts::FRAC_PI_2).abs() < 10.0);
+//! let fast = find_path_hierarchical(&grid, a, b).unwrap();
+//! assert!(fast.length <= HIERARCHICAL_WEIGHT * path.length);
+//! // Pulled straight: one leg along the great circle.
+//! let smooth = smooth_path(&grid, &fast);
+//! assert_eq!(smooth.corners, vec![a, b]);
+//! assert!((smooth.length - 110.0 * std::f64::consts::FRAC_PI_2).abs() < 10.0);
 //! ```
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -32,20 +47,24 @@
 mod agent;
 mod columns;
 mod grid;
+mod hierarchical;
 mod lazy;
 mod report;
 mod rules;
 mod search;
+mod smooth;
 
 pub use agent::{Agent, AgentError};
 pub use columns::{ColumnPlace, Columns, NeighbourPlaces, Neighbours};
 pub use grid::{NavError, NavGrid, Node, NodeId, Step, TileKey, MAX_COLUMNS};
+pub use hierarchical::{find_path_hierarchical, HIERARCHICAL_WEIGHT};
 pub use lazy::{CacheStats, LazyAnswer, LazyGrid, LazyOptions, NodeKey};
 pub use report::{
-    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, waypoint, End, PathAnswer, PATH_FORMAT,
-    PATH_VERSION,
+    lazy_path_geojson, lazy_path_json, path_geojson, path_json, query, query_exact, waypoint, End, PathAnswer,
+    PATH_FORMAT, PATH_VERSION,
 };
 pub use search::{find_path, NoPath, Path, SearchOptions, SearchStats};
+pub use smooth::{smooth_path, SmoothPath};
 
 /// Layouts with more column slots than this (`6 (N + 1)^2`; `n_c n_t` above about 800) are
 /// navigated with the [`LazyGrid`]: a whole-planet [`NavGrid`] of them would take too long to

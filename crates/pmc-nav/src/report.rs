@@ -5,6 +5,7 @@ use crate::agent::Agent;
 use crate::grid::{NavGrid, NodeId};
 use crate::lazy::{LazyAnswer, LazyGrid};
 use crate::search::{NoPath, Path, SearchOptions};
+use crate::smooth::{smooth_path, SmoothPath};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::LatLon;
 use serde_json::{json, Value};
@@ -86,6 +87,8 @@ impl<N> PathAnswer<N> {
 /// What a document says about the grid, beside the answer.
 struct Facts {
     agent: Agent,
+    /// The smoothed path of a path found on the whole-planet grid.
+    smoothed: Option<SmoothPath>,
     /// The `grid` member.
     grid: Value,
     /// The component of a path found.
@@ -95,9 +98,14 @@ struct Facts {
 }
 
 impl Facts {
-    fn eager<N>(grid: &NavGrid, answer: &PathAnswer<N>, first: impl Fn(&Path<N>) -> Option<NodeId>) -> Facts {
+    fn eager(grid: &NavGrid, answer: &PathAnswer) -> Facts {
+        let first = |p: &Path| p.nodes.first().copied();
         Facts {
             agent: *grid.agent(),
+            smoothed: match answer {
+                PathAnswer::Found(p) => Some(smooth_path(grid, p)),
+                _ => None,
+            },
             grid: json!({ "nodes": grid.node_count(), "components": grid.component_sizes().len() }),
             component: match answer {
                 PathAnswer::Found(p) => json!(first(p).and_then(|n| grid.component(n))),
@@ -110,6 +118,7 @@ impl Facts {
     fn lazy(grid: &LazyGrid, answer: &LazyAnswer, options: &SearchOptions) -> Facts {
         Facts {
             agent: *grid.agent(),
+            smoothed: None,
             grid: json!({
                 "lazy": true,
                 "tiles": grid.cache_stats().tiles,
@@ -150,6 +159,11 @@ fn json_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End, da
             v["component"] = facts.component;
             v["waypoints"] = json!(w);
             v["expanded"] = json!(p.expanded);
+            if let Some(s) = &facts.smoothed {
+                let corners: Vec<Value> = s.points.iter().map(|q| waypoint(*q, datum)).collect();
+                v["smoothed"] =
+                    json!({ "length": s.length, "legs": s.corners.len().saturating_sub(1), "waypoints": corners });
+            }
         }
         other => {
             v["reason"] = json!(other.reason());
@@ -187,6 +201,14 @@ fn geojson_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End,
     }
     features.push(point(from, "from"));
     features.push(point(to, "to"));
+    if let Some(s) = &facts.smoothed {
+        let line: Vec<Value> = s.points.iter().map(|q| coords(*q)).collect();
+        features.push(json!({
+            "type": "Feature",
+            "geometry": { "type": "LineString", "coordinates": line },
+            "properties": { "role": "smoothed", "length": s.length, "legs": s.corners.len().saturating_sub(1) },
+        }));
+    }
     let mut properties = json!({
         "format": PATH_FORMAT, "version": PATH_VERSION, "found": matches!(answer, PathAnswer::Found(_)),
         "reason": answer.reason(), "cause": answer.cause(),
@@ -197,28 +219,18 @@ fn geojson_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End,
     json!({ "type": "FeatureCollection", "features": features, "properties": properties })
 }
 
-/// The JSON document of a path query from `from` to `to` (the points asked for, planet frame).
+/// The JSON document of a path query from `from` to `to` (the points asked for, planet frame);
+/// a path found comes with its smoothed form ([`smooth_path`]) in a `smoothed` member (spec 1.2).
 pub fn path_json(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
-    json_document(
-        Facts::eager(grid, answer, |p| p.nodes.first().copied()),
-        answer,
-        from,
-        to,
-        datum,
-    )
+    json_document(Facts::eager(grid, answer), answer, from, to, datum)
 }
 
 /// The GeoJSON (RFC 7946) of a path query: a `FeatureCollection` holding the path as a
 /// `LineString` of `[lon, lat, alt]` (when found) and the two ends asked for as `Point`s
-/// (`[lon, lat]`, with the altitude when one was asked for).
+/// (`[lon, lat]`, with the altitude when one was asked for), then the smoothed path
+/// ([`smooth_path`]) as a `LineString` of its corners with `role` `smoothed` (spec 1.2).
 pub fn path_geojson(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
-    geojson_document(
-        Facts::eager(grid, answer, |p| p.nodes.first().copied()),
-        answer,
-        from,
-        to,
-        datum,
-    )
+    geojson_document(Facts::eager(grid, answer), answer, from, to, datum)
 }
 
 /// [`path_json`] of a query of the lazy grid ([`LazyGrid::query`] with `options`): the grid is
@@ -248,17 +260,35 @@ pub fn lazy_path_geojson(
     geojson_document(Facts::lazy(grid, answer, options), &answer.answer, from, to, datum)
 }
 
-/// Finds the path between the walkable ground nearest to `from` and `to`: each end is, in the
+/// Finds a path between the walkable ground nearest to `from` and `to`: each end is, in the
 /// nearest column with nodes within `max_rings` columns, the node nearest to the radius asked
-/// for, or the highest one.
+/// for, or the highest one. The walk comes from the hierarchical search
+/// ([`crate::find_path_hierarchical`]: the same answer as [`crate::find_path`] on whether a path
+/// exists, the walk within [`crate::HIERARCHICAL_WEIGHT`] times the shortest in its corridor).
 pub fn query(grid: &NavGrid, from: End, to: End, max_rings: usize) -> PathAnswer {
+    query_by(grid, from, to, max_rings, crate::hierarchical::find_path_hierarchical)
+}
+
+/// [`query`] with the exact search ([`crate::find_path`]): a shortest walk, found by A* over the
+/// whole grid (slower across long distances on rough ground).
+pub fn query_exact(grid: &NavGrid, from: End, to: End, max_rings: usize) -> PathAnswer {
+    query_by(grid, from, to, max_rings, crate::search::find_path)
+}
+
+fn query_by(
+    grid: &NavGrid,
+    from: End,
+    to: End,
+    max_rings: usize,
+    search: impl Fn(&NavGrid, NodeId, NodeId) -> Result<Path, NoPath>,
+) -> PathAnswer {
     let Some(a) = grid.node_near(from.dir, from.radius, max_rings) else {
         return PathAnswer::NoGround { start: true };
     };
     let Some(b) = grid.node_near(to.dir, to.radius, max_rings) else {
         return PathAnswer::NoGround { start: false };
     };
-    match crate::search::find_path(grid, a, b) {
+    match search(grid, a, b) {
         Ok(p) => PathAnswer::Found(p),
         Err(e) => PathAnswer::NoPath(e),
     }

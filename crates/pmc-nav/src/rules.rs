@@ -101,7 +101,8 @@ impl Rules {
     /// are appended to `words` (`ceil(len / 64)` of them) and floors to `nodes`, lowest first:
     /// every filled layer `k` with `k + 1` sampled and unfilled whose clearance is air (layers
     /// above the samples count as air), its surface point where the density crosses zero
-    /// between `k` and `k + 1`.
+    /// between `k` and `k + 1`. The samples must not be NaN ([`Rules::contract`] maps NaN to
+    /// air).
     pub fn column(
         &self,
         base: i64,
@@ -111,27 +112,36 @@ impl Rules {
         nodes: &mut Vec<Node>,
     ) {
         let at = words.len();
-        words.resize(at + d.len().div_ceil(64), 0);
-        for (b, v) in d.iter().enumerate() {
-            if *v > 0.0 {
-                words[at + b / 64] |= 1 << (b % 64);
+        for chunk in d.chunks(64) {
+            let mut bits = 0u64;
+            for (b, v) in chunk.iter().enumerate() {
+                bits |= u64::from(*v > 0.0) << b;
             }
+            words.push(bits);
         }
         let view = ColumnView {
             base,
             len: d.len() as i64,
             words: &words[at..],
         };
-        for b in 0..d.len().saturating_sub(1) {
-            let k = base + b as i64;
-            if d[b] > 0.0 && d[b + 1] <= 0.0 && view.air(k + 1, k + self.clearance) {
-                let (a, c) = (f64::from(d[b]), f64::from(d[b + 1]));
-                let t = a / (a - c);
-                let (r0, r1) = (radius(k), radius(k + 1));
-                nodes.push(Node {
-                    layer: k as u32,
-                    radius: r0 + t * (r1 - r0),
-                });
+        // Floors: a filled layer under an unfilled one (the samples are never NaN: the contract
+        // maps NaN to air), found word by word from the bits.
+        for (wi, w) in view.words.iter().enumerate() {
+            let next = view.words.get(wi + 1).map_or(0, |n| n & 1);
+            let mut floors = w & !((w >> 1) | (next << 63));
+            while floors != 0 {
+                let b = wi * 64 + floors.trailing_zeros() as usize;
+                floors &= floors - 1;
+                let k = base + b as i64;
+                if b + 1 < d.len() && view.air(k + 1, k + self.clearance) {
+                    let (a, c) = (f64::from(d[b]), f64::from(d[b + 1]));
+                    let t = a / (a - c);
+                    let (r0, r1) = (radius(k), radius(k + 1));
+                    nodes.push(Node {
+                        layer: k as u32,
+                        radius: r0 + t * (r1 - r0),
+                    });
+                }
             }
         }
     }

@@ -385,13 +385,13 @@ impl Heuristic {
 }
 
 /// The whole-planet grid as a search graph: slots are node ids.
-struct Eager<'a> {
-    grid: &'a NavGrid,
-    heuristic: Option<Heuristic>,
+pub(crate) struct Eager<'a> {
+    pub grid: &'a NavGrid,
+    pub heuristic: Option<Heuristic>,
 }
 
 impl Eager<'_> {
-    fn place(&self, id: NodeId) -> Option<(DVec3, IVec3)> {
+    pub(crate) fn place(&self, id: NodeId) -> Option<(DVec3, IVec3)> {
         let (c, _) = self.grid.node(id)?;
         let columns = self.grid.columns();
         Some((columns.direction(c), columns.lattice(columns.place_of(c))))

@@ -768,3 +768,13 @@ impl Planet {
         meshes
     }
 }
+
+/// A planet's chunk batches are its (edited) density at the chunk's samples: from the base cache
+/// when it has one ([`Planet::with_base_cache`]; a batch not held is sampled and kept), with the
+/// edits applied on top, the same bits as [`Planet::density`]'s batch. Readers other than the
+/// mesher (the navigation grid's rebuild after an edit) pay then only for the edits.
+impl pmc_density::ChunkSamples for Planet {
+    fn chunk_samples(&self, grid: &ChunkGrid, out: &mut [f32]) {
+        self.sample(grid.key, grid, out);
+    }
+}

@@ -344,7 +344,9 @@ impl Editing {
         let next = match (nav.take(), op) {
             (Some((rev, mut grid)), Some(op)) if rev + 1 == current.revision => {
                 // In place unless a query is reading it right now.
-                Arc::make_mut(&mut grid).rebuild_for(current.planet.density().as_ref(), op);
+                // From the planet's base cache where it holds the chunks: only the edits are
+                // applied.
+                Arc::make_mut(&mut grid).rebuild_for_from(current.planet.as_ref(), op);
                 Some((current.revision, grid))
             }
             _ => None,

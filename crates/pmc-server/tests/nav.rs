@@ -30,7 +30,7 @@ fn direct_length(planet: &Planet, from: End, to: End) -> f64 {
 }
 
 #[tokio::test]
-async fn path_answers_the_shortest_walk_as_json_or_geojson() {
+async fn path_answers_the_walk_and_its_smoothed_form_as_json_or_geojson() {
     let a = router(AppState::new(small_config()).unwrap());
     let r = get(&a, "/api/v1/path?from=10,10&to=12,40").await;
     assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
@@ -46,7 +46,17 @@ async fn path_answers_the_shortest_walk_as_json_or_geojson() {
         direct_length(&planet, end(10.0, 10.0), end(12.0, 40.0))
     );
     assert_eq!(v["revision"], 0);
+    // The walk pulled straight: shorter, its corners a subset of the waypoints.
+    let smoothed = &v["smoothed"];
+    assert!(
+        smoothed["length"].as_f64().unwrap() <= v["length"].as_f64().unwrap() * 1.0001,
+        "{v}"
+    );
+    assert_eq!(smoothed["waypoints"][0], v["waypoints"][0]);
     let g = get(&a, "/api/v1/path?from=10,10&to=12,40&format=geojson").await.json();
+    let last = g["features"].as_array().unwrap().last().unwrap().clone();
+    assert_eq!(last["properties"]["role"], "smoothed");
+    assert_eq!(last["properties"]["length"], smoothed["length"]);
     assert_eq!(g["type"], "FeatureCollection");
     assert_eq!(g["features"][0]["properties"]["length"], v["length"]);
     // Another agent, another grid: one that cannot climb any slope finds nothing.

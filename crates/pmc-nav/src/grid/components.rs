@@ -1,7 +1,10 @@
 //! Components: the nodes joined by steps, labelled per tile by a union-find over the steps inside
-//! it, then joined across tile borders by a union-find over (tile, local component) pairs.
+//! it, then joined across tile borders by a union-find over (tile, local component) pairs along
+//! the abstract graph's links (the border steps, each pair of pairs once).
 
 use super::{BorderStep, NavGrid, NodeId};
+use crate::columns::Neighbours;
+use pmc_geometry::glam::DVec3;
 
 /// A union-find over `0..n`.
 struct UnionFind(Vec<u32>);
@@ -53,7 +56,7 @@ impl NavGrid {
     /// The tiles that own a neighbour of one of tile `t`'s columns (`t` excluded).
     pub(super) fn neighbour_tiles(&self, t: usize) -> Vec<usize> {
         let mut out = Vec::new();
-        for c in &self.tiles[t].columns {
+        for c in self.tiles[t].columns.iter().filter(|c| self.on_tile_edge(t, **c)) {
             for q in self.columns.neighbours(*c).iter() {
                 let u = self.tile_index(self.tile_of(self.columns.place_of(*q)));
                 if u != t && !out.contains(&u) {
@@ -64,34 +67,77 @@ impl NavGrid {
         out
     }
 
-    /// The components of tile `t` among the steps that stay inside it.
-    pub(super) fn inner_components(&self, t: usize) -> (Vec<u32>, Vec<u32>) {
+    /// The components of tile `t` among the steps that stay inside it: each node's label, each
+    /// component's size, and each component's mean surface point (the abstract graph's nodes).
+    pub(super) fn inner_components(&self, t: usize) -> (Vec<u32>, Vec<u32>, Vec<DVec3>) {
         let tile = &self.tiles[t];
+        let dirs: Vec<DVec3> = tile.columns.iter().map(|c| self.columns.direction(*c)).collect();
         let mut uf = UnionFind::new(tile.nodes.len());
-        let base = self.tile_base[t];
+        let side = (self.columns.face_tiles() + 1) as u32;
         for (lc, column) in tile.columns.iter().enumerate() {
-            for q in self.columns.neighbours(*column).iter() {
-                if tile.columns.binary_search(q).is_err() {
+            let a = self.view(*column);
+            // Inside the tile a column's neighbours are the next ones along the face's rows and
+            // columns (the index is `face (N + 1)^2 + j (N + 1) + i`).
+            let neighbours = if self.on_tile_edge(t, *column) {
+                self.columns.neighbours(*column)
+            } else {
+                Neighbours::of([column + 1, column - 1, column + side, column - side])
+            };
+            for q in neighbours.iter() {
+                // Each pair of columns once: the steps read the same from either end, but not
+                // when the agent's climbs and drops differ, so both ways are tried from the
+                // lower index.
+                let Ok(lq) = tile.columns.binary_search(q) else {
+                    continue;
+                };
+                if lq < lc {
                     continue;
                 }
-                for i in tile.starts[lc]..tile.starts[lc + 1] {
-                    for s in self.steps_into(*column, tile.nodes[i as usize], *q) {
-                        uf.union(i, s.to.0 - base);
+                let b = self.view(*q);
+                let (from, to) = (
+                    tile.starts[lc]..tile.starts[lc + 1],
+                    tile.starts[lq]..tile.starts[lq + 1],
+                );
+                for i in from {
+                    let ni = tile.nodes[i as usize];
+                    for j in to.clone() {
+                        let nj = tile.nodes[j as usize];
+                        if self.rules.step(a, dirs[lc], ni, b, dirs[lq], nj).is_some()
+                            || self.rules.step(b, dirs[lq], nj, a, dirs[lc], ni).is_some()
+                        {
+                            uf.union(i, j);
+                        }
                     }
                 }
             }
         }
-        uf.labels()
+        let (local, sizes) = uf.labels();
+        let mut sums = vec![DVec3::ZERO; sizes.len()];
+        for (lc, dir) in dirs.iter().enumerate() {
+            for i in tile.starts[lc]..tile.starts[lc + 1] {
+                sums[local[i as usize] as usize] += *dir * tile.nodes[i as usize].radius;
+            }
+        }
+        let points = sums
+            .iter()
+            .zip(&sizes)
+            .map(|(s, n)| *s / f64::from((*n).max(1)))
+            .collect();
+        (local, sizes, points)
     }
 
-    /// The steps from tile `t`'s nodes into other tiles: (local node, tile, local node there).
-    pub(super) fn border_steps(&self, t: usize) -> Vec<BorderStep> {
+    /// The steps from tile `t`'s nodes into the other tiles `u` for which `into(u)`: (local
+    /// node, tile, local node there).
+    pub(super) fn border_steps(&self, t: usize, into: impl Fn(usize) -> bool) -> Vec<BorderStep> {
         let tile = &self.tiles[t];
         let mut out = Vec::new();
         for (lc, column) in tile.columns.iter().enumerate() {
+            if !self.on_tile_edge(t, *column) {
+                continue;
+            }
             for q in self.columns.neighbours(*column).iter() {
                 let u = self.tile_index(self.tile_of(self.columns.place_of(*q)));
-                if u == t {
+                if u == t || !into(u) {
                     continue;
                 }
                 for i in tile.starts[lc]..tile.starts[lc + 1] {
@@ -115,11 +161,10 @@ impl NavGrid {
         }
         pair_base.push(pairs);
         let mut uf = UnionFind::new(pairs as usize);
+        // The links are the border steps, each pair of pairs once.
         for (t, tile) in self.tiles.iter().enumerate() {
-            for (from, u, to) in &tile.border {
-                let a = pair_base[t] + tile.local[*from as usize];
-                let b = pair_base[*u as usize] + self.tiles[*u as usize].local[*to as usize];
-                uf.union(a, b);
+            for (from, u, to) in &tile.links {
+                uf.union(pair_base[t] + from, pair_base[*u as usize] + to);
             }
         }
         // Pairs are numbered in node order (tiles in order, local components by first node), so

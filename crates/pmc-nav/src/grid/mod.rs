@@ -22,24 +22,30 @@
 //!   touches are sampled again ([`NavGrid::rebuild_for`]).
 //! - **Components** label the nodes joined by steps (either way), so detached grids (Fig. 10) are
 //!   known without a search: nodes in different components have no path between them.
+//! - **The abstract graph** of the hierarchical search ([`crate::find_path_hierarchical`]): a
+//!   node per (tile, local component) pair, a link per pair of pairs that a border step joins;
+//!   kept up to date by every rebuild, like the components.
 //!
 //! The grid holds every column of the planet, up to [`MAX_COLUMNS`]. [`crate::LazyGrid`] has the
 //! same floors and steps (the rules are one implementation) for planets of any size, built tile
 //! by tile around a query, without components.
 //!
 //! This module holds the types and the build and rebuild by tile; `occupancy` samples a tile's
-//! voxels and floors, `components` labels the components, and `queries` answers for nodes,
+//! voxels and floors, `components` labels the components, `hierarchy` keeps the abstract graph, and `queries` answers for nodes,
 //! steps and the nodes near a place.
 
 mod components;
+mod hierarchy;
 mod occupancy;
 mod queries;
 
 use crate::agent::{Agent, AgentError};
 use crate::columns::{ColumnPlace, Columns};
 use crate::rules::Rules;
-use pmc_density::Density;
+use occupancy::Source;
+use pmc_density::{ChunkSamples, Density};
 use pmc_edit::{affected_chunks, BrushOp};
+use pmc_geometry::glam::DVec3;
 use pmc_geometry::{Face, Layout};
 use rayon::prelude::*;
 
@@ -83,14 +89,21 @@ struct Tile {
     local: Vec<u32>,
     /// Node count of each of those components.
     local_sizes: Vec<u32>,
-    /// Steps that leave the tile.
-    border: Vec<BorderStep>,
+    /// Mean surface point of each local component (the abstract graph's nodes).
+    local_points: Vec<DVec3>,
+    /// Links of the abstract graph out of the tile: (local component, tile, local component
+    /// there), sorted, each once.
+    links: Vec<Link>,
     /// Smallest radius of its nodes' surface points (infinite without nodes).
     min_radius: f64,
 }
 
 /// A step out of a tile: (local node, tile index, local node there).
 type BorderStep = (u32, u32, u32);
+
+/// A link of the abstract graph out of a tile: (local component, tile index, local component
+/// there).
+type Link = (u32, u32, u32);
 
 /// Why a grid could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -172,7 +185,7 @@ impl NavGrid {
         };
         let keys = grid.tile_keys();
         grid.tiles = vec![Tile::default(); keys.len()];
-        grid.rebuild_tiles(density, &keys);
+        grid.rebuild(Source::Density(density), &keys);
         Ok(grid)
     }
 
@@ -193,6 +206,18 @@ impl NavGrid {
     fn tile_index(&self, t: TileKey) -> usize {
         let n_c = self.columns.layout().n_c() as usize;
         (t.face.index() * n_c + t.j as usize) * n_c + t.i as usize
+    }
+
+    /// Whether canonical column `c` of tile `t` lies on the tile's edge: the columns inside it
+    /// have their four neighbours on the same face, one grid step away, in the same tile.
+    fn on_tile_edge(&self, t: usize, c: u32) -> bool {
+        let n_c = i64::from(self.columns.layout().n_c());
+        let (n, n_t) = (self.columns.face_tiles(), i64::from(self.columns.layout().n_t()));
+        let (ti, tj) = (t as i64 % n_c, t as i64 / n_c % n_c);
+        let span = |x: i64| (x * n_t, if x == n_c - 1 { n } else { x * n_t + n_t - 1 });
+        let place = self.columns.place_of(c);
+        let ((ilo, ihi), (jlo, jhi)) = (span(ti), span(tj));
+        !(place.i > ilo && place.i < ihi && place.j > jlo && place.j < jhi)
     }
 
     /// The tile that owns a canonical column place.
@@ -231,17 +256,37 @@ impl NavGrid {
         keys
     }
 
+    /// [`NavGrid::rebuild_for`] reading the tiles' voxels from whole-chunk batches of the edited
+    /// planet: `source` answers for the level-0 chunks under each tile (a `pmc_planet::Planet`
+    /// with a base cache answers from it, applying only its edits, instead of sampling the
+    /// terrain again). The grid is the same, node for node, as a fresh build of the edited
+    /// density: the batches hold the same bits at the same points.
+    pub fn rebuild_for_from(&mut self, source: &dyn ChunkSamples, op: &BrushOp) -> Vec<TileKey> {
+        let keys = self.tiles_for(op);
+        self.rebuild_tiles_from(source, &keys);
+        keys
+    }
+
     /// Samples `density` again under `keys`, then relabels the components: the steps inside the
     /// rebuilt tiles and the steps across the borders of them and of their neighbours are found
-    /// again; the other tiles keep theirs.
+    /// again; the other tiles keep theirs. The abstract graph of the hierarchical search follows.
     pub fn rebuild_tiles(&mut self, density: &dyn Density, keys: &[TileKey]) {
+        self.rebuild(Source::Density(density), keys);
+    }
+
+    /// [`NavGrid::rebuild_tiles`] from whole-chunk batches (see [`NavGrid::rebuild_for_from`]).
+    pub fn rebuild_tiles_from(&mut self, source: &dyn ChunkSamples, keys: &[TileKey]) {
+        self.rebuild(Source::Chunks(source), keys);
+    }
+
+    fn rebuild(&mut self, source: Source, keys: &[TileKey]) {
         if keys.is_empty() && !self.tile_base.is_empty() {
             return;
         }
         let built: Vec<(usize, Tile, Vec<u64>)> = keys
             .par_iter()
             .map(|t| {
-                let (tile, bits) = self.sample_tile(density, *t);
+                let (tile, bits) = self.sample_tile(source, *t);
                 (self.tile_index(*t), tile, bits)
             })
             .collect();
@@ -264,27 +309,47 @@ impl NavGrid {
         self.tile_base = base;
         self.min_radius = self.tiles.iter().map(|t| t.min_radius).fold(f64::INFINITY, f64::min);
         // Steps inside the rebuilt tiles.
-        let inside: Vec<(usize, Vec<u32>, Vec<u32>)> = rebuilt
+        type Inside = (usize, Vec<u32>, Vec<u32>, Vec<DVec3>);
+        let inside: Vec<Inside> = rebuilt
             .par_iter()
             .map(|t| {
-                let (local, sizes) = self.inner_components(*t);
-                (*t, local, sizes)
+                let (local, sizes, points) = self.inner_components(*t);
+                (*t, local, sizes, points)
             })
             .collect();
-        for (t, local, sizes) in inside {
+        for (t, local, sizes, points) in inside {
             self.tiles[t].local = local;
             self.tiles[t].local_sizes = sizes;
+            self.tiles[t].local_points = points;
         }
-        // Steps across borders: of the rebuilt tiles and of every tile next to one.
+        // Steps across borders: of the rebuilt tiles and of every tile next to one, kept as the
+        // abstract graph's links (the border steps between (tile, local component) pairs, each
+        // pair of pairs once).
+        rebuilt.sort_unstable();
+        rebuilt.dedup();
         let mut touched: Vec<usize> = rebuilt.clone();
         for t in &rebuilt {
             touched.extend(self.neighbour_tiles(*t));
         }
         touched.sort_unstable();
         touched.dedup();
-        let borders: Vec<(usize, Vec<BorderStep>)> = touched.par_iter().map(|t| (*t, self.border_steps(*t))).collect();
-        for (t, border) in borders {
-            self.tiles[t].border = border;
+        // A tile next to a rebuilt one keeps its links into the tiles not rebuilt (neither end
+        // changed) and finds those into the rebuilt ones again.
+        let links: Vec<(usize, Vec<Link>)> = touched
+            .par_iter()
+            .map(|t| {
+                if rebuilt.binary_search(t).is_ok() {
+                    return (*t, self.links(*t, &self.border_steps(*t, |_| true)));
+                }
+                let into = |u: usize| rebuilt.binary_search(&u).is_ok();
+                let mut l = self.links(*t, &self.border_steps(*t, into));
+                l.extend(self.tiles[*t].links.iter().filter(|(_, u, _)| !into(*u as usize)));
+                l.sort_unstable();
+                (*t, l)
+            })
+            .collect();
+        for (t, l) in links {
+            self.tiles[t].links = l;
         }
         self.merge_components();
     }
