@@ -24,7 +24,7 @@
 //! only downhill); [`crate::smooth_path`] then pulls it straight.
 
 use crate::grid::{NavGrid, NodeId};
-use crate::search::{astar, find_path, Eager, Halt, Heuristic, NoPath, Outcome, Path, SearchGraph};
+use crate::search::{astar, find_path, Eager, Halt, NoPath, Outcome, Path, SearchGraph};
 
 /// The heuristic weight of the corridor search: its walk is at most this many times the
 /// shortest walk within the corridor (in practice within a few percent of the shortest walk; see
@@ -70,12 +70,7 @@ impl SearchGraph for Corridor<'_> {
 /// [`HIERARCHICAL_WEIGHT`] times the shortest walk within the corridor it searched; `expanded`
 /// counts the corridor search's nodes (and the exact search's, when it had to answer).
 pub fn find_path_hierarchical(grid: &NavGrid, from: NodeId, to: NodeId) -> Result<Path, NoPath> {
-    let (Some(ca), Some(cb)) = (grid.component(from), grid.component(to)) else {
-        return Err(NoPath::OneWay);
-    };
-    if ca != cb {
-        return Err(NoPath::DifferentComponents { from: ca, to: cb });
-    }
+    let eager = Eager::towards(grid, from, to)?;
     let (Some((pa, _)), Some((pb, _))) = (grid.pair_of(from), grid.pair_of(to)) else {
         return Err(NoPath::OneWay);
     };
@@ -98,32 +93,13 @@ pub fn find_path_hierarchical(grid: &NavGrid, from: NodeId, to: NodeId) -> Resul
             add(u, &mut slot_base);
         }
     }
-    let mut eager = Eager { grid, heuristic: None };
-    let (Some((_, start)), Some((goal_dir, goal_lattice))) = (eager.place(from), eager.place(to)) else {
-        return Err(NoPath::OneWay);
-    };
-    eager.heuristic = Some(Heuristic::new(
-        grid.columns(),
-        grid.min_radius(),
-        start,
-        goal_dir,
-        goal_lattice,
-    ));
     let mut corridor = Corridor {
         eager,
         slot_base,
         tiles,
     };
     match astar(&mut corridor, from, to, HIERARCHICAL_WEIGHT, usize::MAX, |_| None) {
-        (Outcome::Found { nodes, length }, expanded) => {
-            let points = nodes.iter().filter_map(|id| grid.position(*id)).collect();
-            Ok(Path {
-                nodes,
-                points,
-                length,
-                expanded,
-            })
-        }
+        (Outcome::Found { nodes, length }, expanded) => Ok(corridor.eager.path(nodes, length, expanded)),
         (_, expanded) => find_path(grid, from, to).map(|mut p| {
             p.expanded += expanded;
             p

@@ -390,7 +390,42 @@ pub(crate) struct Eager<'a> {
     pub heuristic: Option<Heuristic>,
 }
 
-impl Eager<'_> {
+impl<'a> Eager<'a> {
+    /// The grid searched from `from` toward `to`, with the heuristic of the module docs; nodes
+    /// in different components are answered at once (the answer of [`find_path`] and of the
+    /// hierarchical search alike).
+    pub(crate) fn towards(grid: &'a NavGrid, from: NodeId, to: NodeId) -> Result<Eager<'a>, NoPath> {
+        let (Some(ca), Some(cb)) = (grid.component(from), grid.component(to)) else {
+            return Err(NoPath::OneWay);
+        };
+        if ca != cb {
+            return Err(NoPath::DifferentComponents { from: ca, to: cb });
+        }
+        let mut graph = Eager { grid, heuristic: None };
+        let (Some((_, start)), Some((goal_dir, goal_lattice))) = (graph.place(from), graph.place(to)) else {
+            return Err(NoPath::OneWay);
+        };
+        graph.heuristic = Some(Heuristic::new(
+            grid.columns(),
+            grid.min_radius(),
+            start,
+            goal_dir,
+            goal_lattice,
+        ));
+        Ok(graph)
+    }
+
+    /// The path of a walk `nodes` of `length` metres found after expanding `expanded` nodes.
+    pub(crate) fn path(&self, nodes: Vec<NodeId>, length: f64, expanded: usize) -> Path {
+        let points = nodes.iter().filter_map(|id| self.grid.position(*id)).collect();
+        Path {
+            nodes,
+            points,
+            length,
+            expanded,
+        }
+    }
+
     pub(crate) fn place(&self, id: NodeId) -> Option<(DVec3, IVec3)> {
         let (c, _) = self.grid.node(id)?;
         let columns = self.grid.columns();
@@ -427,33 +462,9 @@ impl SearchGraph for Eager<'_> {
 /// with the heuristic of the module docs, `r_min` being the grid's smallest surface radius, so
 /// the path is a shortest one.
 pub fn find_path(grid: &NavGrid, from: NodeId, to: NodeId) -> Result<Path, NoPath> {
-    let (Some(ca), Some(cb)) = (grid.component(from), grid.component(to)) else {
-        return Err(NoPath::OneWay);
-    };
-    if ca != cb {
-        return Err(NoPath::DifferentComponents { from: ca, to: cb });
-    }
-    let mut graph = Eager { grid, heuristic: None };
-    let (Some((_, start)), Some((goal_dir, goal_lattice))) = (graph.place(from), graph.place(to)) else {
-        return Err(NoPath::OneWay);
-    };
-    graph.heuristic = Some(Heuristic::new(
-        grid.columns(),
-        grid.min_radius(),
-        start,
-        goal_dir,
-        goal_lattice,
-    ));
+    let mut graph = Eager::towards(grid, from, to)?;
     match astar(&mut graph, from, to, 1.0, usize::MAX, |_| None) {
-        (Outcome::Found { nodes, length }, expanded) => {
-            let points = nodes.iter().filter_map(|id| grid.position(*id)).collect();
-            Ok(Path {
-                nodes,
-                points,
-                length,
-                expanded,
-            })
-        }
+        (Outcome::Found { nodes, length }, expanded) => Ok(graph.path(nodes, length, expanded)),
         _ => Err(NoPath::OneWay),
     }
 }
