@@ -54,8 +54,9 @@ pub fn affected_chunks(layout: &Layout, op: &BrushOp) -> Vec<ChunkKey> {
 
 /// The chunks of every level of detail whose level-of-detail meshes `op` can change, in key
 /// order: at each level `L`, the chunks whose own padded samples it reaches
-/// ([`affected_chunks_at`]), plus the level-`L` chunks next to a reached level-`L + 1` chunk,
-/// whose seam patches toward that coarser chunk read its samples around the seam
+/// ([`affected_chunks_at`]), plus the level-`L` chunks across a side from a reached level-`L + 1`
+/// chunk (that is not their parent), whose seam patches toward that coarser chunk read its
+/// samples around the seam
 /// (`pmc_planet::Planet::chunk_mesh_lod`). A mesh of any chunk not listed, with any side mask, is
 /// unchanged by `op`.
 pub fn affected_chunks_lod(layout: &Layout, op: &BrushOp) -> Vec<ChunkKey> {
@@ -64,13 +65,21 @@ pub fn affected_chunks_lod(layout: &Layout, op: &BrushOp) -> Vec<ChunkKey> {
     for level in (0..=layout.max_level()).rev() {
         let here = affected_chunks_at(layout, level, op);
         out.extend(&here);
-        // Finer chunks beside a reached coarser one: the children of its same-level neighbours.
+        // Finer chunks beside a reached coarser one `y`: the children of its same-level
+        // neighbours whose seam patch toward a side reads `y`, by the mesher's own rule (the
+        // coarser neighbour across the side is `y`, and not the chunk's own parent).
         for y in &coarser {
             for side in ChunkSide::ALL {
                 let Some(n) = layout.neighbour(y, side, y.level) else {
                     continue;
                 };
-                out.extend(n.children().into_iter().flatten().filter(|c| layout.contains_chunk(c)));
+                out.extend(n.children().into_iter().flatten().filter(|c| {
+                    layout.contains_chunk(c)
+                        && c.parent() != *y
+                        && ChunkSide::ALL
+                            .into_iter()
+                            .any(|s| layout.neighbour(c, s, y.level) == Some(*y))
+                }));
             }
         }
         coarser = here;
@@ -435,6 +444,57 @@ mod tests {
         for key in &want {
             assert!(got.contains(key), "{key}");
         }
+    }
+
+    /// The level-of-detail list by its definition, over every chunk: reached at its level, or
+    /// across a side from a reached chunk one level coarser that is not its parent (the seam
+    /// patch toward it reads its samples).
+    fn lod_by_definition(layout: &Layout, op: &BrushOp) -> Vec<ChunkKey> {
+        let mut out = Vec::new();
+        for level in 0..=layout.max_level() {
+            let here = affected_chunks_at(layout, level, op);
+            let above = affected_chunks_at(layout, level + 1, op);
+            for key in layout.chunks(level) {
+                let reads_reached = ChunkSide::ALL.into_iter().any(|s| {
+                    layout
+                        .neighbour(&key, s, level + 1)
+                        .is_some_and(|y| y != key.parent() && above.contains(&y))
+                });
+                if here.contains(&key) || reads_reached {
+                    out.push(key);
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// A brush at a face's centre, where the chunks of every level meet, reaches a coarse chunk
+    /// of each level; the list took every child of every neighbour of such a chunk (165 chunks
+    /// for a 6 m brush on the default planet, where the definition gives 97, each of them meshed
+    /// again by the server after the edit). Now the list is the definition exactly, there and
+    /// elsewhere near the shell.
+    #[test]
+    fn a_brush_at_a_face_centre_listed_the_children_of_every_neighbour() {
+        let layout = Layout::new(4, 8, 60.0, 1.0, 2).unwrap();
+        let surface = 0.5 * (layout.d_b() + layout.radius());
+        let mut seam_only = 0;
+        for (dir, radius) in [
+            (DVec3::Y, 3.0),
+            (DVec3::new(0.01, 1.0, 0.02), 2.0),
+            (DVec3::new(1.0, 1.0, 0.0), 4.0),
+            (DVec3::new(1.0, 1.0, 1.0), 3.0),
+            (DVec3::new(0.3, 1.0, -0.55), 5.0),
+        ] {
+            let op = BrushOp::new(BrushKind::Remove, dir.normalize() * surface, radius, 1.0).unwrap();
+            let want = lod_by_definition(&layout, &op);
+            assert_eq!(affected_chunks_lod(&layout, &op), want, "{op:?}");
+            let per_level: usize = (0..=layout.max_level())
+                .map(|l| affected_chunks_at(&layout, l, &op).len())
+                .sum();
+            seam_only += want.len() - per_level;
+        }
+        assert!(seam_only > 0, "no brush reached a coarser chunk's seam samples only");
     }
 
     /// The face map stretches lengths by at most 1: the arc between the images of two nearby face
