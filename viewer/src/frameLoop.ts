@@ -112,13 +112,14 @@ export class FrameLoop {
     selection.frame(cameras.camera, viewportHeightPx, pos, basis.forward, basis.up, now, steps.busy() !== null);
     streamer.update();
 
-    if (this.redraw.shouldDraw(now, moved || inputActive(input), streamer.settled())) {
+    const settled = streamer.settled();
+    if (this.redraw.shouldDraw(now, moved || inputActive(input), settled)) {
       renderer.render(scene.scene, cameras.camera);
       this.redraw.drew(now);
     }
 
     const st = streamer.stats();
-    readiness.frame(steps.busy() === null && selection.current() && streamer.settled());
+    readiness.frame(steps.busy() === null && selection.current() && settled);
     if (now - this.lastUiUpdate > 200) {
       this.lastUiUpdate = now;
       const s = cameras.state;

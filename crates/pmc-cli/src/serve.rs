@@ -33,7 +33,8 @@ pub struct ServeArgs {
     #[arg(long, default_value_t = 0, value_name = "N")]
     threads: usize,
 
-    /// Most megabytes (MiB) of encoded chunks kept in memory.
+    /// Most megabytes (MiB) of encoded chunks kept in memory (with --world, a quarter as much
+    /// again for the meshes whose shading an edit reuses).
     #[arg(long = "cache-mb", default_value_t = 512, value_name = "MIB")]
     cache_mb: u64,
 

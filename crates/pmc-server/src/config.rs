@@ -45,7 +45,8 @@ pub struct ServerConfig {
     pub terrain: TerrainSpec,
     /// The layout of every planet served (fixed for the server's life).
     pub layout: Layout,
-    /// Most bytes of encoded chunks kept in the cache (default 512 MiB).
+    /// Most bytes of encoded chunks kept in the cache (default 512 MiB). With a world, a quarter
+    /// as much again holds the world planet's meshes, for reusing their shading after an edit.
     pub cache_bytes: u64,
     /// Most planets (terrains) kept at once, with their cached chunks (default 4).
     pub max_planets: usize,

@@ -193,10 +193,18 @@ struct Reuse {
     previous: ByteCache<ChunkId, (Arc<ChunkMesh>, BrushOp, u64)>,
 }
 
-/// Bytes a mesh holds (its buffers), for the mesh cache's bound.
+/// Bytes a mesh holds (its buffers), for the mesh caches' bound.
 fn mesh_bytes(m: &ChunkMesh) -> u64 {
-    let per_vertex = 12 + 12 + std::mem::size_of::<pmc_geometry::EdgeKey>() + 4 + 4 + 4 + 1;
-    (m.vertex_count() * per_vertex + m.indices.len() * 4 + 64) as u64
+    use std::mem::size_of_val;
+    let buffers = size_of_val(m.positions.as_slice())
+        + size_of_val(m.normals.as_slice())
+        + size_of_val(m.indices.as_slice())
+        + size_of_val(m.edge_keys.as_slice())
+        + size_of_val(m.heights.as_slice())
+        + size_of_val(m.water_depths.as_slice())
+        + size_of_val(m.colors.as_slice())
+        + size_of_val(m.materials.as_slice());
+    (buffers + std::mem::size_of::<ChunkMesh>()) as u64
 }
 
 /// Generates, de-duplicates and caches encoded chunks.
@@ -247,7 +255,8 @@ fn generate(
 impl Generator {
     /// A generator with `threads` workers (0: one per core), at most `queue_limit` waiting jobs
     /// and `cache_bytes` of cache; with `edited`, the planet being edited and the bytes of its
-    /// meshes kept for reusing their shading after an edit.
+    /// meshes kept for reusing their shading after an edit (half for the current meshes, half for
+    /// those before an edit that no job has meshed again yet).
     pub fn new(
         threads: usize,
         queue_limit: usize,
@@ -269,8 +278,8 @@ impl Generator {
                 min_revision: HashMap::new(),
                 meshes: edited.map(|(planet, bytes)| Reuse {
                     planet,
-                    meshes: ByteCache::new(bytes),
-                    previous: ByteCache::new(bytes),
+                    meshes: ByteCache::new(bytes / 2),
+                    previous: ByteCache::new(bytes / 2),
                 }),
                 next_token: 0,
                 counts: JobCounts::default(),
