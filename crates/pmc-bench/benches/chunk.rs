@@ -25,6 +25,18 @@ fn chunk(c: &mut Criterion) {
             mesher.mesh(&grid, &d, &mut out);
         })
     });
+    // The shading alone: the shader over the chunk's vertices, one batch.
+    let points: Vec<pmc_geometry::glam::DVec3> = (0..out.vertex_count()).map(|i| out.world_position(i)).collect();
+    let normals: Vec<pmc_geometry::glam::DVec3> = out.normals.iter().map(|n| n.map(f64::from).into()).collect();
+    let mut shades = Vec::new();
+    g.bench_function(format!("earthlike/shading/vertices={}", points.len()), |b| {
+        b.iter(|| {
+            planet
+                .terrain()
+                .shader
+                .shade_many(&points, &normals, false, &mut shades)
+        })
+    });
     g.finish();
 }
 

@@ -123,6 +123,19 @@ pub fn gradient3_accumulate_offset(
     }
 }
 
+/// Runs `f`, compiled for AVX-512 (F and DQ) where the processor has it: for straight-line
+/// arithmetic over slices (`f` and what it inlines), which the compiler then vectorises eight
+/// lanes wide instead of two. Lane-wise IEEE operations give the same bits at any width (and the
+/// compiler fuses no multiply-add), so the results do not depend on the processor.
+#[inline]
+pub(crate) fn wide<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    if x86::available() {
+        return x86::wide(f);
+    }
+    f()
+}
+
 /// The eight evaluations by the scalar kernel.
 #[inline]
 pub(crate) fn scalar(q: &Lanes8) -> [f64; LANES] {
@@ -141,8 +154,19 @@ pub(crate) mod x86 {
 
     /// Whether this processor runs the kernel (AVX-512 F and DQ).
     #[inline]
-    fn available() -> bool {
+    pub(crate) fn available() -> bool {
         std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq")
+    }
+
+    /// [`super::wide`] on a processor with AVX-512 F and DQ.
+    #[inline]
+    pub(crate) fn wide<R>(f: impl FnOnce() -> R) -> R {
+        #[target_feature(enable = "avx512f,avx512dq")]
+        unsafe fn run<R>(f: impl FnOnce() -> R) -> R {
+            f()
+        }
+        // SAFETY: only called where `available()` holds, the features `run` is compiled for.
+        unsafe { run(f) }
     }
 
     /// The eight evaluations in 512-bit lanes, or `None` on a processor without AVX-512 F and

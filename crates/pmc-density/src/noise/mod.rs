@@ -23,6 +23,7 @@ mod ridged;
 pub use fbm::{Fbm, FbmParams, DEFAULT_FREQUENCY, DEFAULT_GAIN, DEFAULT_LACUNARITY, DEFAULT_OCTAVES};
 pub use gradient::{gradient3, gradient3_pair, GradientNoise, GRADIENT_RAW_MAX};
 pub use hash::{derive_seed, mix64, unit_f64};
+pub(crate) use lanes::wide;
 pub use lanes::{gradient3_accumulate, gradient3_accumulate_offset, gradient3_x8, Lanes8, LANES};
 pub use octave::{octaves_for, MAX_OCTAVES};
 pub use ridged::{Ridged, RidgedParams, DEFAULT_RIDGE_FEEDBACK, DEFAULT_RIDGE_OFFSET};

@@ -16,7 +16,7 @@
 //! | caves              | band from sea level + `l_d` to 2.5 `l_d` under the surface, at most 0.14 T deep; the roof opens in places (cave mouths) | tubes about 2 tiles wide and 3 `l_d` tall, about 12 tiles apart |
 
 use super::features::{
-    lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales, Spaghetti,
+    carved_voxels, lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales, Spaghetti,
 };
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
@@ -293,53 +293,18 @@ impl ColumnModel for EarthModel {
         self.caves.carve(d0, &col.band, dir, r)
     }
 
-    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits, one layer of
-    /// radius at a time: first the displaced terrain everywhere, with the displacement noise of
-    /// the voxels in an overhang's window sampled at once, then the tubes' two noises at once
-    /// where they can carve.
+    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits
+    /// ([`carved_voxels`]).
     fn voxels(&self, cols: &[EarthColumn], dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
-        let n = dirs.len();
-        let (mut d0, mut rs) = (vec![0.0; n], vec![0.0; n]);
-        let (mut noise, mut at) = (NoiseBatch::default(), Vec::new());
-        let (mut n1, mut n2) = (Vec::new(), Vec::new());
-        let (seed_a, seed_b) = self.caves.seeds();
-        for (k, r) in radii.iter().enumerate() {
-            noise.clear();
-            at.clear();
-            for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
-                let r = (*dir * *r).length();
-                let (base, weight) = self.overhang.window(col.h, col.amp, r);
-                (rs[d], d0[d]) = (r, base);
-                if let Some(aw) = weight {
-                    noise.push(self.overhang.point(*dir, r));
-                    at.push((d, aw));
-                }
-            }
-            if !at.is_empty() {
-                noise.values(self.overhang.seed(), &mut n1);
-                for (&(d, aw), v) in at.iter().zip(&n1) {
-                    d0[d] += aw * v;
-                }
-            }
-            noise.clear();
-            at.clear();
-            for (d, (dir, col)) in dirs.iter().zip(cols).enumerate() {
-                if let Some(pen) = self.caves.penalty(d0[d], &col.band, rs[d]) {
-                    noise.push(self.caves.point(*dir, rs[d]));
-                    at.push((d, pen));
-                }
-            }
-            if !at.is_empty() {
-                noise.values(seed_a, &mut n1);
-                noise.values(seed_b, &mut n2);
-                for (j, &(d, pen)) in at.iter().enumerate() {
-                    d0[d] = self.caves.carve_with(d0[d], pen, n1[j], n2[j]);
-                }
-            }
-            for (o, v) in out[k * n..(k + 1) * n].iter_mut().zip(&d0) {
-                *o = *v as f32;
-            }
-        }
+        carved_voxels(
+            Some(&self.overhang),
+            &self.caves,
+            cols,
+            |c| (c.h, c.amp, c.band),
+            dirs,
+            radii,
+            out,
+        );
     }
 
     fn bounds(&self) -> (f64, f64) {

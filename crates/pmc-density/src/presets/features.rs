@@ -12,7 +12,7 @@
 //! - The cave field has a lower bound that needs no noise, `-t S + P(r)`. Where that bound is at
 //!   least `D0`, `min(D0, C) = D0`.
 
-use crate::noise::{gradient3, gradient3_accumulate, gradient3_pair, octaves_for, DEFAULT_LACUNARITY};
+use crate::noise::{gradient3, gradient3_accumulate, gradient3_pair, octaves_for, wide, DEFAULT_LACUNARITY};
 use crate::Density;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
@@ -189,6 +189,136 @@ impl NoiseBatch {
     }
 }
 
+/// The densities of columns whose voxel is `caves.carve(overhang.displace(h, a, dir, r), band,
+/// dir, r)` (no overhangs: `caves.carve(h - r, band, dir, r)`), `parts` giving each column's
+/// `(h, a, band)`: [`ColumnModel::voxels`] for such models, the same bits as the voxel calls.
+///
+/// One layer of radius at a time, in passes over the layer's columns as slices: the radii and
+/// `h - r` with the overhang windows' test (straight-line arithmetic the compiler vectorises),
+/// the displacement noise of the voxels inside a window sampled at once, the caves' noise-free
+/// bound and test, their two noises sampled at once where they can carve, the conversion to
+/// `f32`.
+// The negated comparisons keep `Overhang::window`'s tests exactly, NaN included.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+pub(crate) fn carved_voxels<C>(
+    overhang: Option<&Overhang>,
+    caves: &Spaghetti,
+    cols: &[C],
+    parts: impl Fn(&C) -> (f64, f64, CaveBand),
+    dirs: &[DVec3],
+    radii: &[f64],
+    out: &mut [f32],
+) {
+    let n = dirs.len();
+    assert_eq!(cols.len(), n, "one column a direction");
+    assert_eq!(out.len(), n * radii.len(), "output buffer has the wrong size");
+    let (dx, dy, dz): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+        dirs.iter().map(|d| d.x).collect(),
+        dirs.iter().map(|d| d.y).collect(),
+        dirs.iter().map(|d| d.z).collect(),
+    );
+    let (mut h, mut amp, mut reach) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut mid, mut half) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for c in cols {
+        let (ch, a, band) = parts(c);
+        h.push(ch);
+        amp.push(a);
+        // `Overhang::window` gives no weight where `a <= 0` or `|h - r| >= reach`: an infinite
+        // reach that no `|h - r|` is below stands for the first.
+        reach.push(match overhang {
+            Some(o) if !(a <= 0.0) => o.reach(a),
+            _ => f64::NEG_INFINITY,
+        });
+        mid.push(band.mid);
+        half.push(band.half);
+    }
+    let (mut rs, mut d0, mut aw, mut pen) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut flags = vec![0u8; n];
+    let (mut noise, mut at, mut n1, mut n2) = (NoiseBatch::default(), Vec::new(), Vec::new(), Vec::new());
+    let (seed_a, seed_b) = caves.seeds();
+    let (slope, neg_ts) = (caves.slope, caves.neg_ts);
+    for (k, &rk) in radii.iter().enumerate() {
+        // r = |dir * rk| as glam computes it, `h - r`, and whether an overhang window holds it.
+        // The window's weight `a w` is computed everywhere (read only where the flag is set).
+        wide(|| {
+            let (rs, d0, aw, flags) = (&mut rs[..n], &mut d0[..n], &mut aw[..n], &mut flags[..n]);
+            let (dx, dy, dz, h, amp, reach) = (&dx[..n], &dy[..n], &dz[..n], &h[..n], &amp[..n], &reach[..n]);
+            for d in 0..n {
+                let (x, y, z) = (dx[d] * rk, dy[d] * rk, dz[d] * rk);
+                let r = (x * x + y * y + z * z).sqrt();
+                let b = h[d] - r;
+                rs[d] = r;
+                d0[d] = b;
+                aw[d] = Overhang::weight(amp[d], reach[d], b.abs());
+                flags[d] = !(b.abs() >= reach[d]) as u8;
+            }
+        });
+        if let Some(o) = overhang {
+            noise.clear();
+            at.clear();
+            for_each_flagged(&flags, |d| {
+                noise.push(o.point(dirs[d], rs[d]));
+                at.push((d, aw[d]));
+            });
+            if !at.is_empty() {
+                noise.values(o.seed(), &mut n1);
+                for (&(d, aw), v) in at.iter().zip(&n1) {
+                    d0[d] += aw * v;
+                }
+            }
+        }
+        // The caves' bound without noise, `-t S + P(r)`, and whether it is below `d0`.
+        wide(|| {
+            let (pen, flags) = (&mut pen[..n], &mut flags[..n]);
+            let (rs, d0, mid, half) = (&rs[..n], &d0[..n], &mid[..n], &half[..n]);
+            for d in 0..n {
+                let p = slope * ((rs[d] - mid[d]).abs() - half[d]).max(0.0);
+                pen[d] = p;
+                flags[d] = (neg_ts + p < d0[d]) as u8;
+            }
+        });
+        noise.clear();
+        at.clear();
+        for_each_flagged(&flags, |d| {
+            noise.push(caves.point(dirs[d], rs[d]));
+            at.push((d, pen[d]));
+        });
+        if !at.is_empty() {
+            noise.values(seed_a, &mut n1);
+            noise.values(seed_b, &mut n2);
+            for (j, &(d, p)) in at.iter().enumerate() {
+                d0[d] = caves.carve_with(d0[d], p, n1[j], n2[j]);
+            }
+        }
+        for (o, v) in out[k * n..(k + 1) * n].iter_mut().zip(&d0) {
+            *o = *v as f32;
+        }
+    }
+}
+
+/// Calls `f` with the index of every nonzero flag, in order, skipping eight zero flags at a
+/// time.
+#[inline]
+fn for_each_flagged(flags: &[u8], mut f: impl FnMut(usize)) {
+    let mut chunks = flags.chunks_exact(8);
+    for (c, eight) in chunks.by_ref().enumerate() {
+        let word = u64::from_le_bytes(eight.try_into().expect("eight flags"));
+        if word != 0 {
+            for (j, &b) in eight.iter().enumerate() {
+                if b != 0 {
+                    f(c * 8 + j);
+                }
+            }
+        }
+    }
+    let start = flags.len() / 8 * 8;
+    for (j, &b) in chunks.remainder().iter().enumerate() {
+        if b != 0 {
+            f(start + j);
+        }
+    }
+}
+
 /// Mean gradient magnitude of [`gradient3`] per lattice unit (measured: 1.1), used to turn noise
 /// values into approximate metres.
 const MEAN_NOISE_GRADIENT: f64 = 1.1;
@@ -353,14 +483,25 @@ impl Overhang {
         if a <= 0.0 {
             return (base, None);
         }
-        let reach = a + (0.5 * a + self.min_falloff);
+        let reach = self.reach(a);
         let z = base.abs();
         if z >= reach {
             // w = 1 - smoothstep(a, reach, z) = 0: the formula gives base + 0.
             return (base, None);
         }
-        let w = 1.0 - smoothstep(a, reach, z);
-        (base, Some(a * w))
+        (base, Some(Self::weight(a, reach, z)))
+    }
+
+    /// How far from the surface the window of amplitude `a` reaches (it is zero from there on).
+    #[inline]
+    pub fn reach(&self, a: f64) -> f64 {
+        a + (0.5 * a + self.min_falloff)
+    }
+
+    /// The displacement's weight `a w` at distance `z < reach` from the surface.
+    #[inline]
+    pub fn weight(a: f64, reach: f64, z: f64) -> f64 {
+        a * (1.0 - smoothstep(a, reach, z))
     }
 
     /// Where the displacement noise is sampled at radius `r` along `dir`.
@@ -428,6 +569,48 @@ mod tests {
             }
         }
         assert!(carved > 100, "the test should exercise the carving path: {carved}");
+    }
+
+    #[test]
+    fn carved_voxels_give_the_voxel_formula_bit_for_bit() {
+        let caves = Spaghetti::new((1, 2), 120.0, 50.0, 1900.0, 0.1, 8.0, 256.0);
+        let over = Overhang::new(3, 30.0, 16.0, 1900.0, 4.0);
+        // 203 columns (not a multiple of eight: the flag scan's tail is read too).
+        let cols: Vec<(DVec3, f64, f64, CaveBand)> = (0..203)
+            .map(|i| {
+                let t = i as f64 * 0.0123;
+                let dir = DVec3::new(t.cos(), (t * 0.37).sin(), t.sin() * 0.8).normalize();
+                let h = 1900.0 + 30.0 * (t * 3.1).sin();
+                let a = (12.0 * (t * 1.7).cos()).max(0.0);
+                let band = caves.band(1880.0, h - 5.0, smoothstep(-0.5, 0.5, (t * 0.9).sin()));
+                (dir, h, a, band)
+            })
+            .collect();
+        let dirs: Vec<DVec3> = cols.iter().map(|c| c.0).collect();
+        let radii: Vec<f64> = (0..60).map(|k| 1850.0 + k as f64 * 2.0).collect();
+        let mut out = vec![0.0f32; dirs.len() * radii.len()];
+        let (mut carved, mut displaced) = (0, 0);
+        for overhang in [Some(&over), None] {
+            carved_voxels(overhang, &caves, &cols, |c| (c.1, c.2, c.3), &dirs, &radii, &mut out);
+            for (k, rk) in radii.iter().enumerate() {
+                for (d, (dir, h, a, band)) in cols.iter().enumerate() {
+                    let r = (*dir * *rk).length();
+                    let d0 = match overhang {
+                        Some(o) => o.displace(*h, *a, *dir, r),
+                        None => h - r,
+                    };
+                    displaced += usize::from(d0 != h - r);
+                    let want = caves.carve(d0, band, *dir, r);
+                    carved += usize::from(want < d0);
+                    let got = out[k * dirs.len() + d];
+                    assert_eq!(got.to_bits(), (want as f32).to_bits(), "column {d}, radius {rk}");
+                }
+            }
+        }
+        assert!(
+            carved > 100 && displaced > 100,
+            "both noises are read: {carved} {displaced}"
+        );
     }
 
     #[test]

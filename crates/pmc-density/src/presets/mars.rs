@@ -12,7 +12,7 @@
 //! | caves        | band from 2.5 `l_d` to 0.1 T under the surface, mouths in canyon walls | tubes about 2 tiles wide |
 //! | overhangs    | displacement up to 3 `l_d` on canyon walls      | 3 tiles across, 3 `l_d` deep |
 
-use super::features::{smoothstep, CaveBand, ColumnDensity, ColumnModel, Overhang, Scales, Spaghetti};
+use super::features::{carved_voxels, smoothstep, CaveBand, ColumnDensity, ColumnModel, Overhang, Scales, Spaghetti};
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
 use crate::noise::{derive_seed, gradient3, mix64, unit_f64, Fbm, FbmParams, Ridged, RidgedParams};
@@ -238,6 +238,20 @@ impl ColumnModel for MarsModel {
     fn voxel(&self, col: &MarsColumn, dir: DVec3, _p: DVec3, r: f64) -> f64 {
         let d0 = self.overhang.displace(col.h, col.amp, dir, r);
         self.caves.carve(d0, &col.band, dir, r)
+    }
+
+    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits
+    /// ([`carved_voxels`]).
+    fn voxels(&self, cols: &[MarsColumn], dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        carved_voxels(
+            Some(&self.overhang),
+            &self.caves,
+            cols,
+            |c| (c.h, c.amp, c.band),
+            dirs,
+            radii,
+            out,
+        );
     }
 
     fn bounds(&self) -> (f64, f64) {

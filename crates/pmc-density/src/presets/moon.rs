@@ -8,7 +8,7 @@
 //! | lava tubes | band from 3 `l_d` to 0.1 T under the maria, skylights where the roof opens | tubes about 2.5 tiles wide |
 
 use super::craters::CraterLevel;
-use super::features::{smoothstep, CaveBand, ColumnDensity, ColumnModel, Scales, Spaghetti};
+use super::features::{carved_voxels, smoothstep, CaveBand, ColumnDensity, ColumnModel, Scales, Spaghetti};
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
 use crate::noise::{derive_seed, gradient3, Fbm, FbmParams};
@@ -148,6 +148,12 @@ impl ColumnModel for MoonModel {
     #[inline]
     fn voxel(&self, col: &MoonColumn, dir: DVec3, _p: DVec3, r: f64) -> f64 {
         self.tubes.carve(col.h - r, &col.band, dir, r)
+    }
+
+    /// [`voxel`](Self::voxel) at every voxel of the columns, the same bits
+    /// ([`carved_voxels`], no overhangs).
+    fn voxels(&self, cols: &[MoonColumn], dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
+        carved_voxels(None, &self.tubes, cols, |c| (c.h, 0.0, c.band), dirs, radii, out);
     }
 
     fn bounds(&self) -> (f64, f64) {
