@@ -234,7 +234,7 @@ pub(crate) fn carved_voxels<C>(
     }
     let (mut rs, mut d0, mut aw, mut pen) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut flags = vec![0u8; n];
-    let (mut noise, mut at, mut n1, mut n2) = (NoiseBatch::default(), Vec::new(), Vec::new(), Vec::new());
+    let (mut noise, mut at, mut n1, mut n2) = (NoiseBatch::default(), Vec::<u32>::new(), Vec::new(), Vec::new());
     let (seed_a, seed_b) = caves.seeds();
     let (slope, neg_ts) = (caves.slope, caves.neg_ts);
     for (k, &rk) in radii.iter().enumerate() {
@@ -258,12 +258,13 @@ pub(crate) fn carved_voxels<C>(
             at.clear();
             for_each_flagged(&flags, |d| {
                 noise.push(o.point(dirs[d], rs[d]));
-                at.push((d, aw[d]));
+                at.push(d as u32);
             });
             if !at.is_empty() {
                 noise.values(o.seed(), &mut n1);
-                for (&(d, aw), v) in at.iter().zip(&n1) {
-                    d0[d] += aw * v;
+                for (&d, v) in at.iter().zip(&n1) {
+                    let d = d as usize;
+                    d0[d] += aw[d] * v;
                 }
             }
         }
@@ -281,13 +282,14 @@ pub(crate) fn carved_voxels<C>(
         at.clear();
         for_each_flagged(&flags, |d| {
             noise.push(caves.point(dirs[d], rs[d]));
-            at.push((d, pen[d]));
+            at.push(d as u32);
         });
         if !at.is_empty() {
             noise.values(seed_a, &mut n1);
             noise.values(seed_b, &mut n2);
-            for (j, &(d, p)) in at.iter().enumerate() {
-                d0[d] = caves.carve_with(d0[d], p, n1[j], n2[j]);
+            for (j, &d) in at.iter().enumerate() {
+                let d = d as usize;
+                d0[d] = caves.carve_with(d0[d], pen[d], n1[j], n2[j]);
             }
         }
         for (o, v) in out[k * n..(k + 1) * n].iter_mut().zip(&d0) {
