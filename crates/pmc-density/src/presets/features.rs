@@ -212,27 +212,25 @@ pub(crate) fn carved_voxels<C>(
     let n = dirs.len();
     assert_eq!(cols.len(), n, "one column a direction");
     assert_eq!(out.len(), n * radii.len(), "output buffer has the wrong size");
-    let (dx, dy, dz): (Vec<f64>, Vec<f64>, Vec<f64>) = (
-        dirs.iter().map(|d| d.x).collect(),
-        dirs.iter().map(|d| d.y).collect(),
-        dirs.iter().map(|d| d.z).collect(),
-    );
-    let (mut h, mut amp, mut reach) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
-    let (mut mid, mut half) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    for c in cols {
+    // Twelve arrays of a value per column in one allocation, at a fixed stride (the same layout
+    // every call).
+    let mut store = vec![0.0; 12 * n];
+    let [dx, dy, dz, h, amp, reach, mid, half, rs, d0, aw, pen] = {
+        let mut parts = store.chunks_exact_mut(n);
+        std::array::from_fn(|_| parts.next().expect("twelve arrays"))
+    };
+    for (d, c) in cols.iter().enumerate() {
         let (ch, a, band) = parts(c);
-        h.push(ch);
-        amp.push(a);
+        (dx[d], dy[d], dz[d]) = (dirs[d].x, dirs[d].y, dirs[d].z);
+        (h[d], amp[d]) = (ch, a);
         // `Overhang::window` gives no weight where `a <= 0` or `|h - r| >= reach`: an infinite
         // reach that no `|h - r|` is below stands for the first.
-        reach.push(match overhang {
+        reach[d] = match overhang {
             Some(o) if !(a <= 0.0) => o.reach(a),
             _ => f64::NEG_INFINITY,
-        });
-        mid.push(band.mid);
-        half.push(band.half);
+        };
+        (mid[d], half[d]) = (band.mid, band.half);
     }
-    let (mut rs, mut d0, mut aw, mut pen) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut flags = vec![0u8; n];
     let (mut noise, mut at, mut n1, mut n2) = (NoiseBatch::default(), Vec::<u32>::new(), Vec::new(), Vec::new());
     let (seed_a, seed_b) = caves.seeds();
@@ -292,7 +290,7 @@ pub(crate) fn carved_voxels<C>(
                 d0[d] = caves.carve_with(d0[d], pen[d], n1[j], n2[j]);
             }
         }
-        for (o, v) in out[k * n..(k + 1) * n].iter_mut().zip(&d0) {
+        for (o, v) in out[k * n..(k + 1) * n].iter_mut().zip(d0.iter()) {
             *o = *v as f32;
         }
     }
