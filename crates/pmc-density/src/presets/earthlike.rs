@@ -20,7 +20,7 @@ use super::features::{
 };
 use super::shading::{Material, Palette};
 use super::{PresetKind, Shade, Shader, Terrain};
-use crate::noise::{derive_seed, gradient3, Fbm, FbmParams, Ridged, RidgedParams};
+use crate::noise::{derive_seed, gradient3, gradient3_accumulate, Fbm, FbmParams, Ridged, RidgedParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -278,12 +278,19 @@ impl ColumnModel for EarthModel {
             ridges[i] = *v;
         }
         out.clear();
-        let mut noise = NoiseBatch::default();
-        for d in dirs {
-            noise.push(self.region_point(*d));
-        }
-        let mut regions = Vec::new();
-        noise.values(self.region_seed, &mut regions);
+        // The region noise at `dir * region_freq` (`region_point`): the same product, taken in
+        // the kernel.
+        gather(dirs, &all, &mut xyz);
+        let mut regions = vec![0.0; n];
+        gradient3_accumulate(
+            &xyz[0],
+            &xyz[1],
+            &xyz[2],
+            self.region_freq,
+            self.region_seed,
+            1.0,
+            &mut regions,
+        );
         out.extend((0..n).map(|i| self.finish(land[i].0, hills[i], mountains[i], || ridges[i], regions[i])));
     }
 
@@ -427,16 +434,11 @@ impl Shader for EarthShader {
         // The jitter noise at every point (`0 + 1 n`: a negative zero becomes a positive one,
         // which leaves `z` unchanged).
         let mut noise = NoiseBatch::default();
-        for p in points {
-            noise.push(self.jitter_point(*p));
-        }
+        noise.set_points(points.len(), |i| self.jitter_point(points[i]));
         let mut jitter = Vec::new();
         noise.values(self.jitter_seed, &mut jitter);
         // The forest noise everywhere (only compared with a positive threshold).
-        noise.clear();
-        for d in &dirs {
-            noise.push(self.forest_point(*d));
-        }
+        noise.set_points(dirs.len(), |i| self.forest_point(dirs[i]));
         let mut forest = Vec::new();
         noise.values(self.forest_seed, &mut forest);
         out.clear();
