@@ -260,6 +260,18 @@ impl ColumnModel for EarthModel {
         self.continents
             .sample_slices(&xyz[0], &xyz[1], &xyz[2], &mut continents);
         self.hills.sample_slices(&xyz[0], &xyz[1], &xyz[2], &mut hills);
+        // The region noise at `dir * region_freq` (`region_point`): the same product, taken in
+        // the kernel.
+        let mut regions = vec![0.0; n];
+        gradient3_accumulate(
+            &xyz[0],
+            &xyz[1],
+            &xyz[2],
+            self.region_freq,
+            self.region_seed,
+            1.0,
+            &mut regions,
+        );
         let land: Vec<(f64, f64)> = continents.iter().map(|c| Self::land(*c)).collect();
         let gated: Vec<usize> = (0..n).filter(|&i| land[i].1 > 0.0).collect();
         gather(dirs, &gated, &mut xyz);
@@ -278,19 +290,6 @@ impl ColumnModel for EarthModel {
             ridges[i] = *v;
         }
         out.clear();
-        // The region noise at `dir * region_freq` (`region_point`): the same product, taken in
-        // the kernel.
-        gather(dirs, &all, &mut xyz);
-        let mut regions = vec![0.0; n];
-        gradient3_accumulate(
-            &xyz[0],
-            &xyz[1],
-            &xyz[2],
-            self.region_freq,
-            self.region_seed,
-            1.0,
-            &mut regions,
-        );
         out.extend((0..n).map(|i| self.finish(land[i].0, hills[i], mountains[i], || ridges[i], regions[i])));
     }
 
