@@ -1,6 +1,7 @@
 //! A whole chunk: density batch, shell contract, marching cubes and shading.
 use criterion::{criterion_group, criterion_main, Criterion};
 use pmc_bench::{default_planet, surface_chunk};
+use pmc_geometry::glam::DVec3;
 use pmc_mesh::ChunkMesh;
 use pmc_planet::ChunkScratch;
 
@@ -25,11 +26,33 @@ fn chunk(c: &mut Criterion) {
             mesher.mesh(&grid, &d, &mut out);
         })
     });
-    // The shading alone: the shader over the chunk's vertices, one batch.
-    let points: Vec<pmc_geometry::glam::DVec3> = (0..out.vertex_count()).map(|i| out.world_position(i)).collect();
-    let normals: Vec<pmc_geometry::glam::DVec3> = out.normals.iter().map(|n| n.map(f64::from).into()).collect();
+    // The shading alone: the shader over the chunk's vertices, as the pipeline shades them (from
+    // the density batch's columns at each vertex's edge).
+    let mut kept = pmc_density::ShellColumns::default();
+    planet
+        .terrain()
+        .density
+        .sample_shell_keeping(&grid.dirs, &grid.radii, &mut d, &mut kept);
+    pmc_mesh::close_shell(&grid, planet.layout().depth_tiles(), &mut d);
+    mesher.mesh(&grid, &d, &mut out);
+    let points: Vec<DVec3> = (0..out.vertex_count()).map(|i| out.world_position(i)).collect();
+    let normals: Vec<DVec3> = out.normals.iter().map(|n| n.map(f64::from).into()).collect();
+    let edges: Vec<_> = (0..out.vertex_count())
+        .map(|i| grid.vertex_edge(mesher.vertex_edges()[i], points[i]))
+        .collect();
+    let vertices = pmc_density::presets::EdgeVertices {
+        points: &points,
+        normals: &normals,
+        edges: &edges,
+        dirs: &grid.dirs,
+        columns: &kept,
+    };
     let mut shades = Vec::new();
     g.bench_function(format!("earthlike/shading/vertices={}", points.len()), |b| {
+        b.iter(|| planet.terrain().shader.shade_edges(&vertices, &mut shades))
+    });
+    // The same vertices shaded point by point in one batch (the columns evaluated at every vertex).
+    g.bench_function(format!("earthlike/shading-points/vertices={}", points.len()), |b| {
         b.iter(|| {
             planet
                 .terrain()

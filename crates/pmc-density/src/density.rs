@@ -7,6 +7,7 @@
 //! convention.
 
 use pmc_geometry::glam::DVec3;
+use std::any::Any;
 
 /// A scalar field over world space (metres, planet-centred). Positive is solid.
 ///
@@ -37,11 +38,84 @@ pub trait Density: Send + Sync {
         }
     }
 
+    /// [`sample_shell`](Self::sample_shell) (the same bits into `out`) that also leaves in
+    /// `columns` what the batch computed once per direction, for the terrain's shader to read
+    /// instead of computing it again ([`crate::presets::Shader::shade_edges`]). The default
+    /// leaves `columns` empty; column models keep their columns.
+    ///
+    /// # Panics
+    /// If `out.len() != dirs.len() * radii.len()`.
+    fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
+        columns.clear();
+        self.sample_shell(dirs, radii, out);
+    }
+
     /// Radii between which the surface can lie: below the first everything is solid, above the
     /// second everything is air. `None` when the source cannot tell. Used to skip chunks that
     /// hold no surface without sampling them.
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         None
+    }
+}
+
+/// What a density batch computed once per direction (a column model's columns), kept with the
+/// directions it belongs to ([`Density::sample_shell_keeping`]).
+///
+/// Only a reader of the same model and of exactly the same directions gets the values back
+/// ([`ShellColumns::get`]): anything else finds it empty, and computes the columns itself. So
+/// keeping columns saves work and never changes a result.
+#[derive(Default)]
+pub struct ShellColumns {
+    dirs: Vec<DVec3>,
+    values: Option<Box<dyn Any + Send + Sync>>,
+}
+
+impl std::fmt::Debug for ShellColumns {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShellColumns")
+            .field("dirs", &self.dirs.len())
+            .field("kept", &self.values.is_some())
+            .finish()
+    }
+}
+
+impl ShellColumns {
+    /// Forgets the kept values ([`get`](Self::get) finds nothing until the next
+    /// [`keep`](Self::keep), which reuses their allocation).
+    pub fn clear(&mut self) {
+        self.dirs.clear();
+    }
+
+    /// Whether nothing is kept.
+    pub fn is_empty(&self) -> bool {
+        self.dirs.is_empty()
+    }
+
+    /// The values kept for `dirs` as a slice of `T` (one per direction), if these are exactly the
+    /// directions they were computed for (bit for bit) and they are of type `T`.
+    pub fn get<T: 'static>(&self, dirs: &[DVec3]) -> Option<&[T]> {
+        let values = self.values.as_ref()?.downcast_ref::<Vec<T>>()?;
+        let same = self.dirs.len() == dirs.len()
+            && self
+                .dirs
+                .iter()
+                .zip(dirs)
+                .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits));
+        (same && values.len() == dirs.len()).then_some(values.as_slice())
+    }
+
+    /// Keeps values of type `T` for `dirs`: `fill` writes them into an empty vector (reusing the
+    /// previous allocation when its type matches) and must push one per direction.
+    pub fn keep<T: Send + Sync + 'static>(&mut self, dirs: &[DVec3], fill: impl FnOnce(&mut Vec<T>)) {
+        let mut values: Box<Vec<T>> = match self.values.take().map(|v| v.downcast::<Vec<T>>()) {
+            Some(Ok(v)) => v,
+            _ => Box::default(),
+        };
+        values.clear();
+        fill(&mut values);
+        self.dirs.clear();
+        self.dirs.extend_from_slice(dirs);
+        self.values = Some(values);
     }
 }
 
@@ -51,6 +125,9 @@ impl<T: Density + ?Sized> Density for Box<T> {
     }
     fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
         (**self).sample_shell(dirs, radii, out)
+    }
+    fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
+        (**self).sample_shell_keeping(dirs, radii, out, columns)
     }
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         (**self).radial_bounds()
@@ -63,6 +140,9 @@ impl<T: Density + ?Sized> Density for std::sync::Arc<T> {
     }
     fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
         (**self).sample_shell(dirs, radii, out)
+    }
+    fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
+        (**self).sample_shell_keeping(dirs, radii, out, columns)
     }
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         (**self).radial_bounds()
@@ -167,6 +247,25 @@ mod tests {
             }
         }
         assert!(out[3 * 3] > 0.0, "the bump makes (12,0,0) solid");
+    }
+
+    #[test]
+    fn kept_columns_come_back_only_for_the_same_directions_and_type() {
+        let dirs = [DVec3::X, DVec3::Y];
+        let mut kept = ShellColumns::default();
+        assert!(kept.is_empty() && kept.get::<f64>(&dirs).is_none());
+        kept.keep(&dirs, |v: &mut Vec<f64>| v.extend([1.0, 2.0]));
+        assert_eq!(kept.get::<f64>(&dirs), Some(&[1.0, 2.0][..]));
+        assert!(kept.get::<f32>(&dirs).is_none(), "another type");
+        assert!(kept.get::<f64>(&[DVec3::X]).is_none(), "fewer directions");
+        assert!(kept.get::<f64>(&[DVec3::X, DVec3::Z]).is_none(), "other directions");
+        let nudged = DVec3::new(f64::from_bits(1.0f64.to_bits() - 1), 0.0, 0.0);
+        assert!(kept.get::<f64>(&[nudged, DVec3::Y]).is_none(), "one bit off");
+        // A default batch keeps nothing; a keeper of the wrong count is never read.
+        Sphere { radius: 1.0 }.sample_shell_keeping(&dirs, &[1.0], &mut [0.0; 2], &mut kept);
+        assert!(kept.is_empty() && kept.get::<f64>(&dirs).is_none());
+        kept.keep(&dirs, |v: &mut Vec<f64>| v.push(1.0));
+        assert!(kept.get::<f64>(&dirs).is_none(), "one value for two directions");
     }
 
     #[test]

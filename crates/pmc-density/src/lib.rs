@@ -17,4 +17,4 @@ pub mod presets;
 pub mod terrain;
 
 pub use chunk_samples::ChunkSamples;
-pub use density::{Density, FnDensity, Sphere, Subtract, Union};
+pub use density::{Density, FnDensity, ShellColumns, Sphere, Subtract, Union};

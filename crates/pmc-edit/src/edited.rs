@@ -10,7 +10,7 @@
 use crate::brush::{BrushKind, BrushOp};
 use crate::log::EditSnapshot;
 use crate::region::ConeShell;
-use pmc_density::Density;
+use pmc_density::{Density, ShellColumns};
 use pmc_geometry::glam::DVec3;
 
 /// A density with the shaping operations of an edit snapshot applied, in order.
@@ -165,6 +165,13 @@ impl<D: Density> Density for EditedDensity<D> {
     /// meets the batch's bounding cone shell, applied only to the samples inside its reach.
     fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
         self.base.sample_shell(dirs, radii, out);
+        self.apply_edits(dirs, radii, out);
+    }
+
+    /// The base batch keeping its columns (edits change voxels, not the base's columns), then
+    /// the edits.
+    fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
+        self.base.sample_shell_keeping(dirs, radii, out, columns);
         self.apply_edits(dirs, radii, out);
     }
 

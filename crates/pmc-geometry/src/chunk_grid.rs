@@ -45,6 +45,19 @@ pub struct ChunkGrid {
     pub origin: DVec3,
 }
 
+/// Where a mesh vertex lies on an edge between two of a chunk's samples, by column: what a
+/// shader reads the chunk's per-column values from ([`ChunkGrid::vertex_edge`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexEdge {
+    /// The column of the first end (an index into [`ChunkGrid::dirs`]).
+    pub a: u32,
+    /// The column of the second end (`a` along the depth axis).
+    pub b: u32,
+    /// Where the vertex lies, from 0 at the first end to 1 at the second (0 along the depth
+    /// axis, where both ends are one column).
+    pub t: f64,
+}
+
 impl ChunkGrid {
     /// Builds the grid of `key`. Panics if the key is not a chunk of `layout` (a programming
     /// error: keys from outside must be checked with [`Layout::contains_chunk`]).
@@ -144,6 +157,30 @@ impl ChunkGrid {
     #[inline]
     pub fn index(&self, a: usize, b: usize, c: usize) -> usize {
         (c * self.padded + b) * self.padded + a
+    }
+
+    /// The [`VertexEdge`] of a vertex at world point `p` on the edge between padded samples
+    /// `samples` (flat [`index`](Self::index)es, first end first): their columns, and where `p`
+    /// projects onto the segment between their positions, clamped to `[0, 1]`.
+    ///
+    /// # Panics
+    /// If a sample index is past the grid.
+    pub fn vertex_edge(&self, samples: [u32; 2], p: DVec3) -> VertexEdge {
+        let layer = self.padded * self.padded;
+        let [f, s] = samples.map(|x| x as usize);
+        let (a, b) = (f % layer, s % layer);
+        let t = if a == b {
+            0.0
+        } else {
+            let pf = self.dirs[a] * self.radii[f / layer];
+            let d = self.dirs[b] * self.radii[s / layer] - pf;
+            ((p - pf).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        };
+        VertexEdge {
+            a: a as u32,
+            b: b as u32,
+            t,
+        }
     }
 
     /// World position of padded sample `(a, b, c)`.

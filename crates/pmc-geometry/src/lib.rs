@@ -33,7 +33,7 @@ mod latlon;
 mod layout;
 pub mod math;
 
-pub use chunk_grid::ChunkGrid;
+pub use chunk_grid::{ChunkGrid, VertexEdge};
 pub use cube_sphere::{
     cube_sphere_factor, cube_to_sphere, face_uv_to_cube, face_uv_to_sphere, sphere_to_cube, sphere_to_face_uv,
 };

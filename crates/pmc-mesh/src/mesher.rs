@@ -30,6 +30,8 @@ pub struct Mesher {
     col_basis: Vec<[DVec3; 3]>,
     /// Per padded layer: `1 / r` and `1 / (r[c + 1] - r[c - 1])`.
     inv_radii: Vec<[f64; 2]>,
+    /// Per vertex of the last mesh: the padded samples its edge joins, canonical first end first.
+    vertex_edges: Vec<[u32; 2]>,
 }
 
 impl Mesher {
@@ -48,6 +50,15 @@ impl Mesher {
     /// If `densities.len() != grid.sample_count()`.
     pub fn mesh(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
         self.mesh_with_transitions(grid, densities, &[], out);
+    }
+
+    /// The grid edge of every vertex of the last mesh, in vertex order: the flat indices
+    /// ([`ChunkGrid::index`]) of the two padded samples it lies between, in the canonical order
+    /// every chunk holding the edge uses (along depth the lower layer first, across the surface
+    /// the column with the smaller lattice point first). The vertex lies on the segment between the two samples' positions. Shaders read the
+    /// chunk's columns at the ends instead of evaluating them again at every vertex.
+    pub fn vertex_edges(&self) -> &[[u32; 2]] {
+        &self.vertex_edges
     }
 
     /// Meshes one chunk as [`Mesher::mesh`] does, and closes the seam on every side in
@@ -71,6 +82,7 @@ impl Mesher {
         out.clear();
         out.key = Some(grid.key);
         out.origin = grid.origin;
+        self.vertex_edges.clear();
         let p = grid.padded;
         let total = p * p * p;
         if self.edge_cache.len() < total * 3 {
@@ -375,6 +387,8 @@ impl Ctx<'_> {
         out.normals.push((-grad).as_vec3().to_array());
         out.edge_keys
             .push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
+        let flat = |x: (usize, usize, usize)| g.index(x.0, x.1, x.2) as u32;
+        self.mesher.vertex_edges.push([flat(f), flat(s)]);
         idx
     }
 

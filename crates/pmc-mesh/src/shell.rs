@@ -49,23 +49,18 @@ pub fn close_shell(grid: &ChunkGrid, depth_tiles: i64, densities: &mut [f32]) {
     let layer = grid.padded * grid.padded;
     for (c, slab) in densities.chunks_exact_mut(layer).enumerate() {
         let k = grid.k0 + (c as i64 - 1) * grid.stride;
+        // Selects rather than branches: every sample is written back, so the loops vectorise.
         if k <= 0 {
             for d in slab.iter_mut() {
-                if !crate::is_solid(*d) {
-                    *d = FORCED_SOLID;
-                }
+                *d = if crate::is_solid(*d) { *d } else { FORCED_SOLID };
             }
         } else if k >= depth_tiles {
             for d in slab.iter_mut() {
-                if d.is_nan() || *d > 0.0 {
-                    *d = FORCED_AIR;
-                }
+                *d = if d.is_nan() || *d > 0.0 { FORCED_AIR } else { *d };
             }
         } else {
             for d in slab.iter_mut() {
-                if d.is_nan() {
-                    *d = FORCED_AIR;
-                }
+                *d = if d.is_nan() { FORCED_AIR } else { *d };
             }
         }
     }

@@ -146,3 +146,57 @@ fn nan_samples_become_air_and_the_surface_stays_closed() {
     let w = WeldedMesh::weld(&mesh_planet(&layout, &f));
     check_closed(&w);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(8))]
+    /// Every vertex knows its grid edge ([`Mesher::vertex_edges`]): two adjacent samples, one
+    /// solid and one not, with the vertex on the segment between them; and a vertex shared by
+    /// neighbouring chunks (the same edge key) finds the same two directions, in the same order,
+    /// at the same place between them, so what a shader reads from the ends agrees across seams.
+    #[test]
+    fn vertices_know_their_grid_edge_the_same_way_in_every_chunk(seed in any::<u64>(), n_t in 2u32..6, scale in 0.3f64..1.5) {
+        let layout = Layout::new(2, n_t, 20.0, 1.0, 2).unwrap();
+        let mid = 20.0 + f64::from(n_t * 2) * 0.5;
+        let f = FnDensity(rough_field(seed, scale, mid));
+        let mut mesher = Mesher::new();
+        let mut seen: HashMap<EdgeKey, ([u64; 3], [u64; 3], f64)> = HashMap::new();
+        let mut shared = 0;
+        for key in layout.chunks(0) {
+            let grid = ChunkGrid::new(&layout, key);
+            let mut d = vec![0.0f32; grid.sample_count()];
+            f.sample_shell(&grid.dirs, &grid.radii, &mut d);
+            close_shell(&grid, layout.depth_tiles(), &mut d);
+            let mut m = ChunkMesh::default();
+            mesher.mesh(&grid, &d, &mut m);
+            let edges = mesher.vertex_edges();
+            prop_assert_eq!(edges.len(), m.vertex_count());
+            let p = grid.padded;
+            let coords = |x: u32| {
+                let x = x as usize;
+                [x % p, (x / p) % p, x / (p * p)]
+            };
+            for (i, e) in edges.iter().enumerate() {
+                let (f_, s) = (coords(e[0]), coords(e[1]));
+                let steps: usize = (0..3).map(|k| f_[k].abs_diff(s[k])).sum();
+                prop_assert_eq!(steps, 1, "adjacent samples");
+                let solid = |x: u32| pmc_mesh::is_solid(d[x as usize]);
+                prop_assert!(solid(e[0]) != solid(e[1]), "the surface crosses the edge");
+                let w = m.world_position(i);
+                let ve = grid.vertex_edge(*e, w);
+                let pf = grid.position(f_[0], f_[1], f_[2]);
+                let ps = grid.position(s[0], s[1], s[2]);
+                let on = pf + (ps - pf) * if ve.a == ve.b { (w - pf).length() / (ps - pf).length() } else { ve.t };
+                prop_assert!((on - w).length() < 1e-4, "vertex {i} off its edge by {}", (on - w).length());
+                let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+                let found = (bits(grid.dirs[ve.a as usize]), bits(grid.dirs[ve.b as usize]), ve.t);
+                if let Some(before) = seen.insert(m.edge_keys[i], found) {
+                    shared += 1;
+                    prop_assert_eq!(before.0, found.0);
+                    prop_assert_eq!(before.1, found.1);
+                    prop_assert!((before.2 - found.2).abs() < 1e-6, "t {} against {}", before.2, found.2);
+                }
+            }
+        }
+        prop_assert!(shared > 0, "some vertices lie on chunk borders");
+    }
+}

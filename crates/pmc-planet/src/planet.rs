@@ -3,12 +3,13 @@
 use crate::cache::{BaseCache, BaseCacheStats};
 use crate::heightfield::HeightfieldMode;
 use crate::terrain::{build_terrain, TerrainError};
+use pmc_density::presets::EdgeVertices;
 use pmc_density::presets::{self, PresetKind, Terrain};
 use pmc_density::terrain::TerrainSpec;
-use pmc_density::Density;
+use pmc_density::{Density, ShellColumns};
 use pmc_edit::{affected_chunks, paint_at, BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{ChunkGrid, ChunkKey, ChunkSide, EdgeKey, Layout, SideMask};
+use pmc_geometry::{ChunkGrid, ChunkKey, ChunkSide, EdgeKey, Layout, SideMask, VertexEdge};
 use pmc_mesh::shell::close_sample;
 use pmc_mesh::{close_shell, coarse_voxels, voxel_gradient, ChunkMesh, Mesher, Transition};
 use rayon::prelude::*;
@@ -56,8 +57,18 @@ impl std::fmt::Debug for Planet {
 pub struct ChunkScratch {
     mesher: Mesher,
     densities: Vec<f32>,
+    /// What the density batch kept per column, for the shader.
+    columns: ShellColumns,
     /// Vertex index of each edge key of a previous mesh, for [`Planet::remesh_reusing`].
     previous: EdgeIndex,
+}
+
+/// The grid edges of a marching-cubes mesh's vertices ([`Mesher::vertex_edges`]) and what the
+/// density batch kept, for [`Planet::shade`].
+struct GridEdges<'a> {
+    grid: &'a ChunkGrid,
+    samples: &'a [[u32; 2]],
+    columns: &'a ShellColumns,
 }
 
 /// Vertex index by edge key.
@@ -359,7 +370,7 @@ impl Planet {
     fn mesh_chunk(&self, key: ChunkKey, scratch: &mut ChunkScratch, out: &mut ChunkMesh, reuse: Option<Reuse>) {
         if let Some(h) = &self.heightfield {
             h.mesh(key, SideMask::NONE, out);
-            self.shade(out, None);
+            self.shade(out, None, None);
             return;
         }
         let grid = ChunkGrid::new(&self.layout, key);
@@ -370,23 +381,40 @@ impl Planet {
             return;
         }
         scratch.densities.resize(grid.sample_count(), 0.0);
-        self.sample(key, &grid, &mut scratch.densities);
+        self.sample(key, &grid, &mut scratch.densities, Some(&mut scratch.columns));
         close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
         scratch.mesher.mesh(&grid, &scratch.densities, out);
-        self.shade(out, reuse.map(|r| (r, &mut scratch.previous)));
+        let edges = GridEdges {
+            grid: &grid,
+            samples: scratch.mesher.vertex_edges(),
+            columns: &scratch.columns,
+        };
+        self.shade(out, Some(edges), reuse.map(|r| (r, &mut scratch.previous)));
     }
 
     /// The (edited) density batch of a chunk into `out`: [`Planet::density`]'s batch, through the
-    /// base cache when there is one (same bits either way).
-    fn sample(&self, key: ChunkKey, grid: &ChunkGrid, out: &mut [f32]) {
+    /// base cache when there is one (same bits either way). With `columns`, a batch sampled here
+    /// keeps its columns there for the shader (a batch from the cache keeps none).
+    fn sample(&self, key: ChunkKey, grid: &ChunkGrid, out: &mut [f32], columns: Option<&mut ShellColumns>) {
+        fn batch(density: &dyn Density, grid: &ChunkGrid, out: &mut [f32], columns: Option<&mut ShellColumns>) {
+            match columns {
+                Some(c) => density.sample_shell_keeping(&grid.dirs, &grid.radii, out, c),
+                None => density.sample_shell(&grid.dirs, &grid.radii, out),
+            }
+        }
         let Some(cache) = &self.base_cache else {
-            self.density.sample_shell(&grid.dirs, &grid.radii, out);
+            batch(&*self.density, grid, out, columns);
             return;
         };
         match cache.get(&key) {
-            Some(base) if base.len() == out.len() => out.copy_from_slice(&base),
+            Some(base) if base.len() == out.len() => {
+                if let Some(c) = columns {
+                    c.clear();
+                }
+                out.copy_from_slice(&base)
+            }
             _ => {
-                self.terrain.density.sample_shell(&grid.dirs, &grid.radii, out);
+                batch(&*self.terrain.density, grid, out, columns);
                 cache.insert(key, Arc::from(&*out));
             }
         }
@@ -451,7 +479,7 @@ impl Planet {
     ) {
         if let Some(h) = &self.heightfield {
             h.mesh(key, coarser, out);
-            self.shade(out, None);
+            self.shade(out, None, None);
             return;
         }
         let grid = ChunkGrid::new(&self.layout, key);
@@ -462,7 +490,7 @@ impl Planet {
             return;
         }
         scratch.densities.resize(grid.sample_count(), 0.0);
-        self.sample(key, &grid, &mut scratch.densities);
+        self.sample(key, &grid, &mut scratch.densities, Some(&mut scratch.columns));
         close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
         let sides: Vec<(ChunkSide, Vec<DVec3>)> = if self.layout.n_t().is_multiple_of(2) {
             coarser
@@ -487,7 +515,12 @@ impl Planet {
         scratch
             .mesher
             .mesh_with_transitions(&grid, &scratch.densities, &transitions, out);
-        self.shade(out, reuse.map(|r| (r, &mut scratch.previous)));
+        let edges = GridEdges {
+            grid: &grid,
+            samples: scratch.mesher.vertex_edges(),
+            columns: &scratch.columns,
+        };
+        self.shade(out, Some(edges), reuse.map(|r| (r, &mut scratch.previous)));
     }
 
     /// Meshes a chunk of any level with its seams closed toward coarser neighbours (allocating
@@ -680,7 +713,10 @@ impl Planet {
     /// material's colour by the brush strength (see [`pmc_density::presets::Shader::shade_material`]).
     /// With `reuse`, vertices unchanged by the edit copy their attributes from the previous mesh
     /// (see [`Planet::remesh_reusing`]), looked up through the scratch map that comes with it.
-    fn shade(&self, m: &mut ChunkMesh, reuse: Option<(Reuse, &mut EdgeIndex)>) {
+    /// With `edges` (a marching-cubes mesh) the shader reads the chunk's columns at each vertex's
+    /// edge ([`pmc_density::presets::Shader::shade_edges`]); without (a height-field mesh) it
+    /// shades the points, which lie on the surface.
+    fn shade(&self, m: &mut ChunkMesh, edges: Option<GridEdges>, reuse: Option<(Reuse, &mut EdgeIndex)>) {
         let datum = self.datum_radius();
         let sea = self.terrain.sea_radius;
         let paints = self.paints_for(m);
@@ -698,34 +734,54 @@ impl Planet {
         });
         // Vertices unchanged by the edit take the previous mesh's attributes; the others are
         // shaded in one batch.
-        let previous: Vec<Option<usize>> = (0..n)
-            .map(|i| {
-                let (r, index) = reuse.as_ref()?;
-                let same = |j: &u32| {
-                    let j = *j as usize;
-                    let bits = |v: [f32; 3]| v.map(f32::to_bits);
-                    bits(r.previous.positions[j]) == bits(m.positions[i])
-                        && bits(r.previous.normals[j]) == bits(m.normals[i])
-                };
-                let outside = (m.world_position(i) - r.op.center).length() >= r.op.reach();
-                index
-                    .get(&m.edge_keys[i])
-                    .filter(|j| outside && same(j))
-                    .map(|j| *j as usize)
-            })
-            .collect();
-        let (points, normals): (Vec<DVec3>, Vec<DVec3>) = (0..n)
-            .filter(|&i| previous[i].is_none())
-            .map(|i| (m.world_position(i), DVec3::from(m.normals[i].map(f64::from))))
-            .unzip();
-        // A height-field vertex lies on the surface: the shader need not look it up.
+        let previous: Vec<Option<usize>> = match &reuse {
+            None => Vec::new(),
+            Some((r, index)) => (0..n)
+                .map(|i| {
+                    let same = |j: &u32| {
+                        let j = *j as usize;
+                        let bits = |v: [f32; 3]| v.map(f32::to_bits);
+                        bits(r.previous.positions[j]) == bits(m.positions[i])
+                            && bits(r.previous.normals[j]) == bits(m.normals[i])
+                    };
+                    let outside = (m.world_position(i) - r.op.center).length() >= r.op.reach();
+                    index
+                        .get(&m.edge_keys[i])
+                        .filter(|j| outside && same(j))
+                        .map(|j| *j as usize)
+                })
+                .collect(),
+        };
+        let reused = |i: usize| previous.get(i).copied().flatten();
+        let todo: Vec<usize> = (0..n).filter(|&i| reused(i).is_none()).collect();
+        let points: Vec<DVec3> = todo.iter().map(|&i| m.world_position(i)).collect();
+        let normals: Vec<DVec3> = todo.iter().map(|&i| DVec3::from(m.normals[i].map(f64::from))).collect();
         let mut shades = Vec::with_capacity(points.len());
-        self.terrain
-            .shader
-            .shade_many(&points, &normals, self.heightfield.is_some(), &mut shades);
-        let mut shaded = shades.into_iter();
-        for (i, prev) in previous.into_iter().enumerate() {
-            if let (Some(j), Some((r, _))) = (prev, &reuse) {
+        match edges {
+            Some(e) => {
+                // Where each vertex lies on its edge is taken from its stored position, so a
+                // vertex whose position and edge are unchanged gets the same shade (what reusing
+                // shades relies on).
+                let at: Vec<VertexEdge> = todo
+                    .iter()
+                    .zip(&points)
+                    .map(|(&i, p)| e.grid.vertex_edge(e.samples[i], *p))
+                    .collect();
+                let vertices = EdgeVertices {
+                    points: &points,
+                    normals: &normals,
+                    edges: &at,
+                    dirs: &e.grid.dirs,
+                    columns: e.columns,
+                };
+                self.terrain.shader.shade_edges(&vertices, &mut shades);
+            }
+            // A height-field vertex lies on the surface: the shader need not look it up.
+            None => self.terrain.shader.shade_many(&points, &normals, true, &mut shades),
+        }
+        let mut shaded = points.iter().zip(shades);
+        for i in 0..n {
+            if let (Some(j), Some((r, _))) = (reused(i), &reuse) {
                 let prev = r.previous;
                 m.heights.push(prev.heights[j]);
                 m.water_depths.push(prev.water_depths[j]);
@@ -733,9 +789,8 @@ impl Planet {
                 m.materials.push(prev.materials[j]);
                 continue;
             }
-            let p = m.world_position(i);
+            let (&p, mut shade) = shaded.next().expect("one shade per vertex to shade");
             let r = p.length();
-            let mut shade = shaded.next().expect("one shade per vertex to shade");
             if let Some((material, strength)) = paint_at(&paints, p) {
                 let paint = self.terrain.shader.shade_material(material, p);
                 let mix = |a: u8, b: u8| (f64::from(a) + (f64::from(b) - f64::from(a)) * strength).round() as u8;
@@ -775,6 +830,6 @@ impl Planet {
 /// mesher (the navigation grid's rebuild after an edit) pay then only for the edits.
 impl pmc_density::ChunkSamples for Planet {
     fn chunk_samples(&self, grid: &ChunkGrid, out: &mut [f32]) {
-        self.sample(grid.key, grid, out);
+        self.sample(grid.key, grid, out, None);
     }
 }

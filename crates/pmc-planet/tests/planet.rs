@@ -87,7 +87,9 @@ fn same_parameters_give_identical_meshes_at_any_thread_count() {
     assert_eq!(digest(&one), GOLDEN_EARTHLIKE_42, "digest {:#x}", digest(&one));
 }
 
-const GOLDEN_EARTHLIKE_42: u64 = 0xd43d_ba4b_15c0_4c58;
+// Changed when chunk vertices came to be shaded from the columns at their edge's ends
+// (`Shader::shade_edges`) instead of columns evaluated at each vertex.
+const GOLDEN_EARTHLIKE_42: u64 = 0x395f_f756_10cc_6d83;
 
 #[test]
 fn earthlike_has_seas_caves_and_overhangs() {
@@ -140,4 +142,37 @@ proptest! {
         let kind = if mars { PresetKind::Mars } else { PresetKind::Moon };
         assert_closed(&generate(&Planet::new(kind, seed, layout), 2));
     }
+}
+
+/// Chunk vertices are shaded from the chunk's columns at their edge's ends, interpolated across
+/// the surface, not from columns evaluated at each vertex: the look must not change. On the
+/// earthlike planet (seas, mountains, snow, caves, overhangs), almost every vertex gets the
+/// material the point shader gives, and the others lie where a material boundary crosses the
+/// vertex's edge.
+#[test]
+fn shading_from_edge_columns_keeps_the_point_shaders_materials() {
+    let planet = Planet::new(PresetKind::Earthlike, 7, Layout::default());
+    let meshes = generate(&planet, 2);
+    let (mut same, mut total) = (0usize, 0usize);
+    let mut seen = std::collections::HashSet::new();
+    for m in &meshes {
+        let points: Vec<DVec3> = (0..m.vertex_count()).map(|i| m.world_position(i)).collect();
+        let normals: Vec<DVec3> = m.normals.iter().map(|n| DVec3::from(n.map(f64::from))).collect();
+        let mut shades = Vec::new();
+        planet
+            .terrain()
+            .shader
+            .shade_many(&points, &normals, false, &mut shades);
+        for (s, material) in shades.iter().zip(&m.materials) {
+            total += 1;
+            same += usize::from(s.material == *material);
+            seen.insert(*material);
+        }
+    }
+    assert!(seen.len() >= 5, "materials seen: {seen:?}");
+    let agree = same as f64 / total as f64;
+    assert!(
+        agree > 0.999,
+        "{same} of {total} vertices keep their material ({agree})"
+    );
 }

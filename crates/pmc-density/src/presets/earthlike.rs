@@ -19,7 +19,7 @@ use super::features::{
     carved_voxels, lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales, Spaghetti,
 };
 use super::shading::{Material, Palette};
-use super::{PresetKind, Shade, Shader, Terrain};
+use super::{EdgeVertices, PresetKind, Shade, Shader, Terrain};
 use crate::noise::{derive_seed, gradient3, gradient3_accumulate, Fbm, FbmParams, Ridged, RidgedParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
@@ -355,7 +355,7 @@ impl EarthShader {
         let (r, dir) = radial(p);
         let jitter = || gradient3(self.jitter_point(p), self.jitter_seed);
         let forest = || gradient3(self.forest_point(dir), self.forest_seed);
-        self.material_in(&self.model.column(dir), r, dir, normal, jitter, forest)
+        self.material_in(&(&self.model.column(dir)).into(), r, dir, normal, jitter, forest)
     }
 
     /// Where the forest noise is sampled along `dir`.
@@ -375,7 +375,7 @@ impl EarthShader {
     #[allow(clippy::too_many_arguments)]
     fn material_in(
         &self,
-        col: &EarthColumn,
+        col: &ShadeColumn,
         r: f64,
         dir: DVec3,
         normal: DVec3,
@@ -410,24 +410,44 @@ impl EarthShader {
     }
 }
 
-/// `(|p|, p / |p|)`, with the direction `+y` at the centre.
-#[inline]
-fn radial(p: DVec3) -> (f64, DVec3) {
-    let r = p.length();
-    (r, if r > 0.0 { p / r } else { DVec3::Y })
+/// What the shader reads of a column.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ShadeColumn {
+    /// Surface radius of the height field.
+    h: f64,
+    /// Overhang displacement amplitude.
+    amp: f64,
+    /// Mountain mask.
+    mountains: f64,
 }
 
-impl Shader for EarthShader {
-    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material(p, normal), p)
+impl From<&EarthColumn> for ShadeColumn {
+    fn from(c: &EarthColumn) -> Self {
+        ShadeColumn {
+            h: c.h,
+            amp: c.amp,
+            mountains: c.mountains,
+        }
     }
+}
 
-    /// One batch of columns ([`EarthModel::columns`]) for all the points.
-    fn shade_many(&self, points: &[DVec3], normals: &[DVec3], _on_surface: bool, out: &mut Vec<Shade>) {
-        assert_eq!(points.len(), normals.len(), "one normal per point");
+impl ShadeColumn {
+    /// The column a fraction `t` of the way to `other`, every value interpolated.
+    fn lerp(&self, other: &ShadeColumn, t: f64) -> ShadeColumn {
+        ShadeColumn {
+            h: lerp(self.h, other.h, t),
+            amp: lerp(self.amp, other.amp, t),
+            mountains: lerp(self.mountains, other.mountains, t),
+        }
+    }
+}
+
+impl EarthShader {
+    /// The shades at `points` (normals `normals`) in columns `cols`: the material from the height
+    /// bands and the slope, the colour mixed by the palette's noise; every noise over all the
+    /// points at once.
+    fn shade_columns(&self, points: &[DVec3], normals: &[DVec3], cols: &[ShadeColumn], out: &mut Vec<Shade>) {
         let (radii, dirs): (Vec<f64>, Vec<DVec3>) = points.iter().map(|p| radial(*p)).unzip();
-        let mut cols = Vec::with_capacity(points.len());
-        self.model.columns(&dirs, &mut cols);
         let mut mix = Vec::with_capacity(points.len());
         self.palette.mix_many(points, &mut mix);
         // The jitter noise at every point (`0 + 1 n`: a negative zero becomes a positive one,
@@ -446,6 +466,74 @@ impl Shader for EarthShader {
             self.palette.shade_mixed(material, mix[i])
         }));
     }
+}
+
+/// `(|p|, p / |p|)`, with the direction `+y` at the centre.
+#[inline]
+fn radial(p: DVec3) -> (f64, DVec3) {
+    let r = p.length();
+    (r, if r > 0.0 { p / r } else { DVec3::Y })
+}
+
+impl Shader for EarthShader {
+    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
+        self.palette.shade(self.material(p, normal), p)
+    }
+
+    /// One batch of columns ([`EarthModel::columns`]) for all the points.
+    fn shade_many(&self, points: &[DVec3], normals: &[DVec3], _on_surface: bool, out: &mut Vec<Shade>) {
+        assert_eq!(points.len(), normals.len(), "one normal per point");
+        let dirs: Vec<DVec3> = points.iter().map(|p| radial(*p).1).collect();
+        let mut cols = Vec::with_capacity(points.len());
+        self.model.columns(&dirs, &mut cols);
+        let cols: Vec<ShadeColumn> = cols.iter().map(ShadeColumn::from).collect();
+        self.shade_columns(points, normals, &cols, out);
+    }
+
+    /// The columns at the chunk's directions (the batch's, or those the edges name, computed
+    /// once each), interpolated across the surface at the vertices of lateral edges.
+    fn shade_edges(&self, v: &EdgeVertices<'_>, out: &mut Vec<Shade>) {
+        v.check();
+        let computed;
+        let (cols, slot): (&[EarthColumn], Option<Vec<u32>>) = match v.columns.get::<EarthColumn>(v.dirs) {
+            Some(cols) => (cols, None),
+            None => {
+                // Only the directions some edge ends at, each once.
+                let mut slot = vec![u32::MAX; v.dirs.len()];
+                let mut used = Vec::new();
+                for e in v.edges {
+                    for d in [e.a, e.b] {
+                        if slot[d as usize] == u32::MAX {
+                            slot[d as usize] = used.len() as u32;
+                            used.push(v.dirs[d as usize]);
+                        }
+                    }
+                }
+                let mut cols = Vec::with_capacity(used.len());
+                self.model.columns(&used, &mut cols);
+                computed = cols;
+                (&computed, Some(slot))
+            }
+        };
+        let col = |d: u32| match &slot {
+            Some(slot) => &cols[slot[d as usize] as usize],
+            None => &cols[d as usize],
+        };
+        let at: Vec<ShadeColumn> = v
+            .edges
+            .iter()
+            .map(|e| {
+                let a = ShadeColumn::from(col(e.a));
+                if e.a == e.b {
+                    a
+                } else {
+                    a.lerp(&ShadeColumn::from(col(e.b)), e.t)
+                }
+            })
+            .collect();
+        self.shade_columns(v.points, v.normals, &at, out);
+    }
+
     fn shade_material(&self, material: u8, p: DVec3) -> Shade {
         self.palette.shade_or_unknown(material, p)
     }
@@ -468,11 +556,59 @@ pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
 mod tests {
     use super::*;
     use crate::presets::testing::*;
-    use crate::Density;
+    use crate::{Density, ShellColumns};
+    use pmc_geometry::VertexEdge;
 
     fn terrain(seed: u64) -> (Terrain, Arc<EarthModel>) {
         let layout = Layout::default();
         (build(seed, &layout), Arc::new(EarthModel::new(seed, &layout)))
+    }
+
+    #[test]
+    fn shading_edges_from_kept_columns_gives_the_same_bits_as_computing_them() {
+        let (ter, m) = terrain(3);
+        let dirs = sphere_dirs(3000);
+        let edges: Vec<VertexEdge> = (0..2400u32)
+            .map(|i| VertexEdge {
+                a: i,
+                b: if i % 3 == 0 { i } else { (i * 7 + 1) % 3000 },
+                t: f64::from(i % 10) / 9.0,
+            })
+            .collect();
+        // Points on the surface and below it (cave rock), normals from flat to steep.
+        let points: Vec<DVec3> = edges
+            .iter()
+            .map(|e| {
+                let (a, b) = (dirs[e.a as usize], dirs[e.b as usize]);
+                let depth = if e.a % 5 == 0 { 4.0 * m.s.l_d } else { 0.0 };
+                (a + (b - a) * e.t).normalize() * (m.column(a).h - depth)
+            })
+            .collect();
+        let normals: Vec<DVec3> = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.normalize() + DVec3::X * (i % 4) as f64 * 0.5).normalize())
+            .collect();
+        let mut kept = ShellColumns::default();
+        let mut out = vec![0.0; dirs.len()];
+        ter.density.sample_shell_keeping(&dirs, &[m.sea], &mut out, &mut kept);
+        assert!(!kept.is_empty(), "the earthlike batch keeps its columns");
+        let shade = |columns: &ShellColumns| {
+            let v = EdgeVertices {
+                points: &points,
+                normals: &normals,
+                edges: &edges,
+                dirs: &dirs,
+                columns,
+            };
+            let mut shades = Vec::new();
+            ter.shader.shade_edges(&v, &mut shades);
+            shades
+        };
+        let from_batch = shade(&kept);
+        assert_eq!(from_batch, shade(&ShellColumns::default()));
+        let materials: std::collections::HashSet<u8> = from_batch.iter().map(|s| s.material).collect();
+        assert!(materials.len() >= 4, "{materials:?}");
     }
 
     #[test]

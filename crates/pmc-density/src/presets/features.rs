@@ -13,7 +13,7 @@
 //!   least `D0`, `min(D0, C) = D0`.
 
 use crate::noise::{gradient3, gradient3_accumulate, gradient3_pair, octaves_for, wide, DEFAULT_LACUNARITY};
-use crate::Density;
+use crate::{Density, ShellColumns};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -68,7 +68,7 @@ impl Scales {
 /// A density split into per-direction work (the column) and per-radius work (the voxel).
 pub(crate) trait ColumnModel: Send + Sync + 'static {
     /// What a column computes once for all its radii.
-    type Column;
+    type Column: Send + Sync + 'static;
     /// The column along unit direction `dir`.
     fn column(&self, dir: DVec3) -> Self::Column;
     /// The columns along many unit directions into `out` (cleared first): the same values as
@@ -118,6 +118,14 @@ impl<M: ColumnModel> Density for ColumnDensity<M> {
         let mut cols = Vec::with_capacity(n);
         self.0.columns(dirs, &mut cols);
         self.0.voxels(&cols, dirs, radii, out);
+    }
+
+    /// The batch, keeping its columns (`Vec<M::Column>`, one per direction) for the shader.
+    fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
+        assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
+        columns.keep(dirs, |cols| self.0.columns(dirs, cols));
+        let cols = columns.get::<M::Column>(dirs).expect("the columns just kept");
+        self.0.voxels(cols, dirs, radii, out);
     }
 
     fn radial_bounds(&self) -> Option<(f64, f64)> {

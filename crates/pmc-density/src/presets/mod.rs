@@ -12,10 +12,10 @@ mod sphere;
 #[cfg(test)]
 pub(crate) mod testing;
 
-use crate::Density;
+use crate::{Density, ShellColumns};
 pub use layouts::{layout_for_radius, RadiusError, EARTH_RADIUS, MAX_RADIUS, MIN_RADIUS};
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::Layout;
+use pmc_geometry::{Layout, VertexEdge};
 use std::sync::Arc;
 
 /// The named presets.
@@ -131,6 +131,22 @@ pub trait Shader: Send + Sync {
         }));
     }
 
+    /// The shades of a chunk's mesh vertices, each on an edge between two of the chunk's samples:
+    /// `out[i]` (after `out` is cleared) is the shade of vertex `i`. Shaders that compute
+    /// something once per column (a direction from the planet's centre) override it to compute
+    /// it at the chunk's column directions only, or take it from the density batch's
+    /// [`ShellColumns`], and read each vertex's value from its edge's two ends, interpolated
+    /// across the surface at the vertex. The result depends only on the vertex's point, normal
+    /// and edge and on the directions, never on whether the batch's columns were kept. The
+    /// default is [`shade_many`](Self::shade_many) at the points.
+    ///
+    /// Panics when the slices of `vertices` differ in length or an edge names a direction past
+    /// `vertices.dirs` (a caller's bug).
+    fn shade_edges(&self, vertices: &EdgeVertices<'_>, out: &mut Vec<Shade>) {
+        vertices.check();
+        self.shade_many(vertices.points, vertices.normals, false, out);
+    }
+
     /// The shade of material `material` (an index into [`Terrain::materials`]) at world point
     /// `p`, whatever the terrain would put there (used to paint materials by hand). The default is
     /// a neutral grey; the presets use their palettes. Ids past the material list get the grey.
@@ -140,6 +156,36 @@ pub trait Shader: Send + Sync {
             color: UNKNOWN_MATERIAL_COLOR,
             material,
         }
+    }
+}
+
+/// Mesh vertices on the edges of a chunk's sample grid, for [`Shader::shade_edges`].
+#[derive(Clone, Copy, Debug)]
+pub struct EdgeVertices<'a> {
+    /// World positions (metres, planet-centred).
+    pub points: &'a [DVec3],
+    /// Unit outward normals.
+    pub normals: &'a [DVec3],
+    /// Per vertex, its edge: the columns of the two ends (indices into `dirs`; equal for an edge
+    /// along the depth axis) and where the vertex lies between them, `t` in `[0, 1]` from the
+    /// first end.
+    pub edges: &'a [VertexEdge],
+    /// The unit directions of the chunk's columns.
+    pub dirs: &'a [DVec3],
+    /// What the density batch over `dirs` kept ([`Density::sample_shell_keeping`]), or empty.
+    pub columns: &'a ShellColumns,
+}
+
+impl EdgeVertices<'_> {
+    /// Panics on slices of different lengths or an edge past the directions.
+    pub(crate) fn check(&self) {
+        assert_eq!(self.points.len(), self.normals.len(), "one normal per point");
+        assert_eq!(self.points.len(), self.edges.len(), "one edge per point");
+        let n = self.dirs.len();
+        assert!(
+            self.edges.iter().all(|e| (e.a as usize) < n && (e.b as usize) < n),
+            "an edge names a direction past the chunk's"
+        );
     }
 }
 

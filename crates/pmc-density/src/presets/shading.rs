@@ -5,6 +5,7 @@ use super::Shade;
 use crate::noise::{Fbm, FbmParams};
 use pmc_geometry::glam::DVec3;
 
+use pmc_geometry::math::round_to_byte;
 pub(crate) use pmc_geometry::math::srgb_to_linear;
 
 /// A material: two colours, linear RGB in `[0, 1]`, mixed by a noise value.
@@ -26,11 +27,7 @@ impl Material {
     /// The colour at mix `t` in `[0, 1]` (0 gives the first colour), opaque, linear RGBA u8.
     pub fn color(&self, t: f64) -> [u8; 4] {
         let t = t.clamp(0.0, 1.0);
-        let ch = |i: usize| {
-            ((self.a[i] + (self.b[i] - self.a[i]) * t) * 255.0)
-                .round()
-                .clamp(0.0, 255.0) as u8
-        };
+        let ch = |i: usize| round_to_byte((self.a[i] + (self.b[i] - self.a[i]) * t) * 255.0);
         [ch(0), ch(1), ch(2), 255]
     }
 }
