@@ -221,12 +221,12 @@ pub(crate) fn carved_voxels<C>(
     if n == 0 {
         return;
     }
-    // Twelve arrays of a value per column in one allocation, at a fixed stride (the same layout
+    // Eleven arrays of a value per column in one allocation, at a fixed stride (the same layout
     // every call).
-    let mut store = vec![0.0; 12 * n];
-    let [dx, dy, dz, h, amp, reach, mid, half, rs, d0, aw, pen] = {
+    let mut store = vec![0.0; 11 * n];
+    let [dx, dy, dz, h, amp, reach, mid, half, rs, d0, pen] = {
         let mut parts = store.chunks_exact_mut(n);
-        std::array::from_fn(|_| parts.next().expect("twelve arrays"))
+        std::array::from_fn(|_| parts.next().expect("eleven arrays"))
     };
     for (d, c) in cols.iter().enumerate() {
         let (ch, a, band) = parts(c);
@@ -246,17 +246,15 @@ pub(crate) fn carved_voxels<C>(
     let (slope, neg_ts) = (caves.slope, caves.neg_ts);
     for (k, &rk) in radii.iter().enumerate() {
         // r = |dir * rk| as glam computes it, `h - r`, and whether an overhang window holds it.
-        // The window's weight `a w` is computed everywhere (read only where the flag is set).
         wide(|| {
-            let (rs, d0, aw, flags) = (&mut rs[..n], &mut d0[..n], &mut aw[..n], &mut flags[..n]);
-            let (dx, dy, dz, h, amp, reach) = (&dx[..n], &dy[..n], &dz[..n], &h[..n], &amp[..n], &reach[..n]);
+            let (rs, d0, flags) = (&mut rs[..n], &mut d0[..n], &mut flags[..n]);
+            let (dx, dy, dz, h, reach) = (&dx[..n], &dy[..n], &dz[..n], &h[..n], &reach[..n]);
             for d in 0..n {
                 let (x, y, z) = (dx[d] * rk, dy[d] * rk, dz[d] * rk);
                 let r = (x * x + y * y + z * z).sqrt();
                 let b = h[d] - r;
                 rs[d] = r;
                 d0[d] = b;
-                aw[d] = Overhang::weight(amp[d], reach[d], b.abs());
                 flags[d] = !(b.abs() >= reach[d]) as u8;
             }
         });
@@ -268,9 +266,10 @@ pub(crate) fn carved_voxels<C>(
             });
             if !at.is_empty() {
                 noise.values(o.seed(), &mut n1);
+                // The window's weight `a w` only where it holds the voxel (a division each).
                 for (&d, v) in at.iter().zip(&n1) {
                     let d = d as usize;
-                    d0[d] += aw[d] * v;
+                    d0[d] += Overhang::weight(amp[d], reach[d], d0[d].abs()) * v;
                 }
             }
         }
