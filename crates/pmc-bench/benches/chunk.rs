@@ -38,7 +38,7 @@ fn chunk(c: &mut Criterion) {
     let points: Vec<DVec3> = (0..out.vertex_count()).map(|i| out.world_position(i)).collect();
     let normals: Vec<DVec3> = out.normals.iter().map(|n| n.map(f64::from).into()).collect();
     let edges: Vec<_> = (0..out.vertex_count())
-        .map(|i| grid.vertex_edge(mesher.vertex_edges()[i], points[i]))
+        .map(|i| grid.vertex_edge(out.vertex_edges[i], points[i]))
         .collect();
     let vertices = pmc_density::presets::EdgeVertices {
         points: &points,

@@ -25,7 +25,10 @@ pub trait Density: Send + Sync {
     /// rounding of the direction (a point call has to normalise `p`, which may differ from the
     /// batch's unit direction in the last bit). Chunks always sample through this call with
     /// canonical directions, so voxels shared by several chunks get identical values.
-    /// Must be deterministic: the same inputs give the same bits.
+    /// Must be deterministic: the same inputs give the same bits. A sample's value must not
+    /// depend on the batch's other directions and radii: a batch over part of a chunk's samples
+    /// gives them the bits the whole chunk's batch gives them (remeshing around an edit samples
+    /// only a box of the chunk).
     ///
     /// # Panics
     /// If `out.len() != dirs.len() * radii.len()`.

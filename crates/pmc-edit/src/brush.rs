@@ -107,6 +107,29 @@ impl BrushOp {
         }
     }
 
+    /// The span of radii `(lo, hi)` where points `dir * r` of the column along `dir` may lie
+    /// within [`reach`](Self::reach) of the centre: the exact span widened by a generous slack
+    /// for rounding, so every point with `|dir r - center| < reach` (computed in `f64`) has
+    /// `lo <= r <= hi`. `None` when the column passes wide of the reach, or `dir` is zero or NaN.
+    pub fn column_span(&self, dir: DVec3) -> Option<(f64, f64)> {
+        let (c, reach) = (self.center, self.reach());
+        let slack = 1e-7 * (c.length() + reach) + 1e-7;
+        let outer = reach + slack;
+        let len2 = dir.length_squared();
+        if len2.is_nan() || len2 == 0.0 {
+            return None;
+        }
+        // Distance from the centre to the column's line, and the span of `r` where the line is
+        // inside the (slightly enlarged) ball.
+        let t = dir.dot(c) / len2;
+        let perp = (c - dir * t).length();
+        if perp.is_nan() || perp > outer {
+            return None;
+        }
+        let half = (outer * outer - perp * perp).max(0.0).sqrt() / len2.sqrt() + slack;
+        Some((t - half, t + half))
+    }
+
     /// Whether the brush changes the density (every kind but paint).
     pub fn shapes(&self) -> bool {
         !matches!(self.kind, BrushKind::Paint { .. })

@@ -97,25 +97,12 @@ impl<D: Density> EditedDensity<D> {
             if !bound.may_meet_ball(c, reach) {
                 continue;
             }
-            // Columns prefilter: generous slack for rounding; the exact test `q < reach` below
-            // decides, identically for every batch.
-            let slack = 1e-7 * (c.length() + reach) + 1e-7;
-            let outer = reach + slack;
+            // Columns prefilter (generous); the exact test `q < reach` below decides,
+            // identically for every batch.
             for (di, d) in dirs.iter().enumerate() {
-                let t = d.dot(c);
-                let len2 = d.length_squared();
-                if len2.is_nan() || len2 == 0.0 {
+                let Some((lo, hi)) = op.column_span(*d) else {
                     continue;
-                }
-                // Distance from the centre to the column's line, and the span of `r` where the
-                // line is inside the (slightly enlarged) ball.
-                let t = t / len2;
-                let perp = (c - *d * t).length();
-                if perp.is_nan() || perp > outer {
-                    continue;
-                }
-                let half = (outer * outer - perp * perp).max(0.0).sqrt() / len2.sqrt() + slack;
-                let (lo, hi) = (t - half, t + half);
+                };
                 for (ri, r) in radii.iter().enumerate() {
                     if !(*r >= lo && *r <= hi) {
                         continue;

@@ -94,7 +94,8 @@ impl DecodedChunk {
         self.normals.iter().map(|n| n.map(snorm_to_f32)).collect()
     }
 
-    /// The chunk as a [`ChunkMesh`] (normals decoded, no edge keys).
+    /// The chunk as a [`ChunkMesh`] (normals decoded; no edge keys, grid edges or cube runs,
+    /// which the encoding does not carry).
     pub fn to_chunk_mesh(&self) -> ChunkMesh {
         ChunkMesh {
             key: Some(self.key),
@@ -107,6 +108,8 @@ impl DecodedChunk {
             water_depths: self.water_depths.clone(),
             colors: self.colors.clone(),
             materials: self.materials.clone(),
+            vertex_edges: Vec::new(),
+            cube_runs: Vec::new(),
         }
     }
 }

@@ -67,6 +67,7 @@ fn fixture_mesh() -> ChunkMesh {
             [200, 100, 50, 128],
         ],
         materials: vec![0, 1, 2, 5, 255],
+        ..ChunkMesh::default()
     }
 }
 

@@ -259,6 +259,7 @@ fn arb_mesh() -> impl Strategy<Value = ChunkMesh> {
             water_depths: attrs.iter().map(|&a| a as f32 * 0.5).collect(),
             colors: attrs.iter().map(|&a| [a; 4]).collect(),
             materials: attrs.clone(),
+            ..ChunkMesh::default()
         })
 }
 

@@ -33,6 +33,19 @@ pub struct ChunkMesh {
     pub colors: Vec<[u8; 4]>,
     /// Material id (see the terrain's material list).
     pub materials: Vec<u8>,
+    /// Per vertex of a marching-cubes mesh, the grid edge it lies on: the flat indices
+    /// ([`pmc_geometry::ChunkGrid::index`]) of the two padded samples it lies between, in the
+    /// canonical order every chunk holding the edge uses (along depth the lower layer first,
+    /// across the surface the column with the smaller lattice point first). Empty for meshes made
+    /// otherwise (height-field patches). Shaders read the chunk's columns at the two ends.
+    pub vertex_edges: Vec<[u32; 2]>,
+    /// The cubes of a marching-cubes mesh that emitted triangles, in emission order (the order of
+    /// their flat indices): the flat index of the cube's lowest corner, and the end of its
+    /// triangles (a triangle count; the cube's triangles start where the previous cube's end).
+    /// Transition patches (level-of-detail seams) are not cubes: their triangles come after the
+    /// last cube's. Remeshing after an edit copies the triangles of the cubes the edit cannot
+    /// change from here ([`crate::Mesher::remesh_cubes`]).
+    pub cube_runs: Vec<[u32; 2]>,
 }
 
 impl ChunkMesh {
@@ -48,6 +61,8 @@ impl ChunkMesh {
         self.water_depths.clear();
         self.colors.clear();
         self.materials.clear();
+        self.vertex_edges.clear();
+        self.cube_runs.clear();
     }
 
     /// Number of vertices.

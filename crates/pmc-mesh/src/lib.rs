@@ -10,6 +10,7 @@
 
 mod chunk_mesh;
 mod mesher;
+mod region;
 pub mod shell;
 pub mod tables;
 pub mod topology;
@@ -17,6 +18,7 @@ pub mod transition;
 
 pub use chunk_mesh::ChunkMesh;
 pub use mesher::{is_solid, voxel_gradient, Mesher};
+pub use region::CubeBox;
 pub use shell::close_shell;
 pub use topology::{ManifoldReport, WeldedMesh};
 pub use transition::{coarse_voxels, Transition};

@@ -17,9 +17,9 @@ pub fn is_solid(d: f32) -> bool {
 /// meshing an empty or sparse chunk costs little more than reading its samples.
 #[derive(Debug, Default)]
 pub struct Mesher {
-    generation: u32,
+    pub(crate) generation: u32,
     /// Per padded voxel and axis: `(generation << 32) | vertex index`.
-    edge_cache: Vec<u64>,
+    pub(crate) edge_cache: Vec<u64>,
     /// Per padded voxel: generation of the cached gradient.
     grad_stamp: Vec<u32>,
     grad: Vec<DVec3>,
@@ -30,59 +30,15 @@ pub struct Mesher {
     col_basis: Vec<[DVec3; 3]>,
     /// Per padded layer: `1 / r` and `1 / (r[c + 1] - r[c - 1])`.
     inv_radii: Vec<[f64; 2]>,
-    /// Per vertex of the last mesh: the padded samples its edge joins, canonical first end first.
-    vertex_edges: Vec<[u32; 2]>,
 }
 
 impl Mesher {
-    /// A mesher with empty caches (they grow to the first chunk's size).
-    pub fn new() -> Mesher {
-        Mesher::default()
-    }
-
-    /// Meshes one chunk into `out` (cleared first; buffers keep their capacity).
-    ///
-    /// `densities` are the padded samples of `grid` in [`ChunkGrid::index`] order. Only the
-    /// chunk's own `n_t^3` tiles are meshed; the padding feeds the gradients. Attribute buffers
-    /// (heights, colours, ...) are left empty for the caller to fill.
-    ///
-    /// # Panics
-    /// If `densities.len() != grid.sample_count()`.
-    pub fn mesh(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
-        self.mesh_with_transitions(grid, densities, &[], out);
-    }
-
-    /// The grid edge of every vertex of the last mesh, in vertex order: the flat indices
-    /// ([`ChunkGrid::index`]) of the two padded samples it lies between, in the canonical order
-    /// every chunk holding the edge uses (along depth the lower layer first, across the surface
-    /// the column with the smaller lattice point first). The vertex lies on the segment between the two samples' positions. Shaders read the
-    /// chunk's columns at the ends instead of evaluating them again at every vertex.
-    pub fn vertex_edges(&self) -> &[[u32; 2]] {
-        &self.vertex_edges
-    }
-
-    /// Meshes one chunk as [`Mesher::mesh`] does, and closes the seam on every side in
-    /// `transitions`, across which the neighbour is one level coarser, with transition patches
-    /// (see [`crate::transition`]). With no transitions the result is [`Mesher::mesh`]'s.
-    ///
-    /// # Panics
-    /// If `densities.len() != grid.sample_count()`.
-    pub fn mesh_with_transitions(
-        &mut self,
-        grid: &ChunkGrid,
-        densities: &[f32],
-        transitions: &[crate::transition::Transition],
-        out: &mut ChunkMesh,
-    ) {
-        assert_eq!(
-            densities.len(),
-            grid.sample_count(),
-            "densities must cover the padded chunk grid"
-        );
+    /// Readies the caches for meshing `grid` into `out` (cleared, keyed to the grid): a new
+    /// generation of the vertex and gradient stamps, and the layers' reciprocal radii.
+    pub(crate) fn start(&mut self, grid: &ChunkGrid, out: &mut ChunkMesh) {
         out.clear();
         out.key = Some(grid.key);
         out.origin = grid.origin;
-        self.vertex_edges.clear();
         let p = grid.padded;
         let total = p * p * p;
         if self.edge_cache.len() < total * 3 {
@@ -106,6 +62,44 @@ impl Mesher {
             let dr = grid.radii[(c + 1).min(p - 1)] - grid.radii[c.saturating_sub(1)];
             [1.0 / grid.radii[c], 1.0 / dr]
         }));
+    }
+
+    /// A mesher with empty caches (they grow to the first chunk's size).
+    pub fn new() -> Mesher {
+        Mesher::default()
+    }
+
+    /// Meshes one chunk into `out` (cleared first; buffers keep their capacity).
+    ///
+    /// `densities` are the padded samples of `grid` in [`ChunkGrid::index`] order. Only the
+    /// chunk's own `n_t^3` tiles are meshed; the padding feeds the gradients. Attribute buffers
+    /// (heights, colours, ...) are left empty for the caller to fill.
+    ///
+    /// # Panics
+    /// If `densities.len() != grid.sample_count()`.
+    pub fn mesh(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
+        self.mesh_with_transitions(grid, densities, &[], out);
+    }
+
+    /// Meshes one chunk as [`Mesher::mesh`] does, and closes the seam on every side in
+    /// `transitions`, across which the neighbour is one level coarser, with transition patches
+    /// (see [`crate::transition`]). With no transitions the result is [`Mesher::mesh`]'s.
+    ///
+    /// # Panics
+    /// If `densities.len() != grid.sample_count()`.
+    pub fn mesh_with_transitions(
+        &mut self,
+        grid: &ChunkGrid,
+        densities: &[f32],
+        transitions: &[crate::transition::Transition],
+        out: &mut ChunkMesh,
+    ) {
+        assert_eq!(
+            densities.len(),
+            grid.sample_count(),
+            "densities must cover the padded chunk grid"
+        );
+        self.start(grid, out);
         let tables = &*TABLES;
         let mut ctx = Ctx {
             grid,
@@ -113,7 +107,7 @@ impl Mesher {
             mesher: self,
             out,
         };
-        if p <= 128 {
+        if grid.padded <= 128 {
             march_bit_rows(&mut ctx, tables);
         } else {
             march_plain(&mut ctx, tables);
@@ -126,7 +120,7 @@ impl Mesher {
 /// Normalises the gradient normals in one tight pass (it vectorises, unlike a square root and a
 /// division per vertex inside the march). A zero or non-finite gradient falls back to the
 /// radial direction.
-fn finish_normals(out: &mut ChunkMesh) {
+pub(crate) fn finish_normals(out: &mut ChunkMesh) {
     for n in out.normals.iter_mut() {
         let len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
         let inv = 1.0 / len2.sqrt();
@@ -298,14 +292,14 @@ pub fn voxel_gradient(
 pub(crate) struct Ctx<'a> {
     pub(crate) grid: &'a ChunkGrid,
     pub(crate) densities: &'a [f32],
-    mesher: &'a mut Mesher,
+    pub(crate) mesher: &'a mut Mesher,
     pub(crate) out: &'a mut ChunkMesh,
 }
 
 impl Ctx<'_> {
     /// Emits the triangles of one cube: each cut edge's vertex is looked up once.
     #[inline]
-    fn emit_cube(&mut self, tables: &crate::tables::McTables, case: u8, a: usize, b: usize, c: usize) {
+    pub(crate) fn emit_cube(&mut self, tables: &crate::tables::McTables, case: u8, a: usize, b: usize, c: usize) {
         let mut verts = [0u32; 12];
         let mut mask = tables.edge_masks[case as usize];
         while mask != 0 {
@@ -316,6 +310,8 @@ impl Ctx<'_> {
         for tri in tables.case(case) {
             self.out.indices.extend_from_slice(&tri.map(|e| verts[e as usize]));
         }
+        let end = (self.out.indices.len() / 3) as u32;
+        self.out.cube_runs.push([self.grid.index(a, b, c) as u32, end]);
     }
 
     /// The vertex on cube edge `e` of the cube whose lowest corner is padded voxel `(a, b, c)`.
@@ -388,7 +384,7 @@ impl Ctx<'_> {
         out.edge_keys
             .push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
         let flat = |x: (usize, usize, usize)| g.index(x.0, x.1, x.2) as u32;
-        self.mesher.vertex_edges.push([flat(f), flat(s)]);
+        out.vertex_edges.push([flat(f), flat(s)]);
         idx
     }
 

@@ -11,7 +11,7 @@ use pmc_edit::{affected_chunks, paint_at, BrushKind, BrushOp, EditSnapshot, Edit
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkGrid, ChunkKey, ChunkSide, EdgeKey, Layout, SideMask, VertexEdge};
 use pmc_mesh::shell::close_sample;
-use pmc_mesh::{close_shell, coarse_voxels, voxel_gradient, ChunkMesh, Mesher, Transition};
+use pmc_mesh::{close_shell, coarse_voxels, voxel_gradient, ChunkMesh, CubeBox, Mesher, Transition};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -59,15 +59,19 @@ pub struct ChunkScratch {
     densities: Vec<f32>,
     /// What the density batch kept per column, for the shader.
     columns: ShellColumns,
+    /// The grid of the last chunk meshed.
+    grid: Option<ChunkGrid>,
+    /// Per vertex of a mesh remeshed around an edit, the previous mesh's vertex it was copied
+    /// from (`u32::MAX`: marched anew).
+    copied: Vec<u32>,
     /// Vertex index of each edge key of a previous mesh, for [`Planet::remesh_reusing`].
     previous: EdgeIndex,
 }
 
-/// The grid edges of a marching-cubes mesh's vertices ([`Mesher::vertex_edges`]) and what the
-/// density batch kept, for [`Planet::shade`].
+/// The grid of a marching-cubes mesh (whose vertices' grid edges are in
+/// [`ChunkMesh::vertex_edges`]) and what the density batch kept, for [`Planet::shade`].
 struct GridEdges<'a> {
     grid: &'a ChunkGrid,
-    samples: &'a [[u32; 2]],
     columns: &'a ShellColumns,
 }
 
@@ -138,6 +142,15 @@ impl Hasher for KeyHasher {
 struct Reuse<'a> {
     previous: &'a ChunkMesh,
     op: &'a BrushOp,
+}
+
+/// A [`Reuse`] as [`Planet::shade`] takes it: with the scratch map of the previous mesh's
+/// vertices by edge key and, for a mesh remeshed around the edit, the previous vertex each vertex
+/// was copied from.
+struct Reused<'a, 'b> {
+    reuse: Reuse<'a>,
+    index: &'b mut EdgeIndex,
+    copied: Option<&'b [u32]>,
 }
 
 /// What the samples of a chunk are known to hold before sampling.
@@ -373,23 +386,121 @@ impl Planet {
             self.shade(out, None, None);
             return;
         }
-        let grid = ChunkGrid::new(&self.layout, key);
+        let grid = self.grid_after(key, scratch.grid.take());
+        self.mesh_chunk_in(&grid, scratch, out, reuse);
+        scratch.grid = Some(grid);
+    }
+
+    /// The sample grid of `key`: `last` (the grid of the chunk meshed before) moved to `key`'s
+    /// depth when it has the same footprint (its directions copied, not computed again: the
+    /// chunks an edit touches come in depth pairs, and a planet's chunks in depth order), else
+    /// a new one. The same grid either way ([`ChunkGrid::at_depth`]).
+    fn grid_after(&self, key: ChunkKey, last: Option<ChunkGrid>) -> ChunkGrid {
+        match last {
+            Some(g) if g.key == key => g,
+            Some(g) if g.key == ChunkKey { k: g.key.k, ..key } => g.at_depth(&self.layout, key.k),
+            _ => ChunkGrid::new(&self.layout, key),
+        }
+    }
+
+    /// [`Planet::mesh_chunk`] on the chunk's grid.
+    fn mesh_chunk_in(&self, grid: &ChunkGrid, scratch: &mut ChunkScratch, out: &mut ChunkMesh, reuse: Option<Reuse>) {
+        let key = grid.key;
         if !self.may_hold_surface(&key) {
             out.clear();
             out.key = Some(key);
             out.origin = grid.origin;
             return;
         }
+        if let Some(r) = &reuse {
+            if self.remesh_around(grid, r, scratch, out) {
+                let edges = GridEdges {
+                    grid,
+                    columns: &scratch.columns,
+                };
+                let reuse = reuse.map(|r| Reused {
+                    reuse: r,
+                    index: &mut scratch.previous,
+                    copied: Some(&scratch.copied),
+                });
+                self.shade(out, Some(edges), reuse);
+                return;
+            }
+        }
         scratch.densities.resize(grid.sample_count(), 0.0);
-        self.sample(key, &grid, &mut scratch.densities, Some(&mut scratch.columns));
-        close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
-        scratch.mesher.mesh(&grid, &scratch.densities, out);
+        self.sample(key, grid, &mut scratch.densities, Some(&mut scratch.columns));
+        close_shell(grid, self.layout.depth_tiles(), &mut scratch.densities);
+        scratch.mesher.mesh(grid, &scratch.densities, out);
         let edges = GridEdges {
-            grid: &grid,
-            samples: scratch.mesher.vertex_edges(),
+            grid,
             columns: &scratch.columns,
         };
-        self.shade(out, Some(edges), reuse.map(|r| (r, &mut scratch.previous)));
+        self.shade(
+            out,
+            Some(edges),
+            reuse.map(|r| Reused {
+                reuse: r,
+                index: &mut scratch.previous,
+                copied: None,
+            }),
+        );
+    }
+
+    /// Meshes the chunk of `grid` after the edit `r.op` by marching again only the cubes the
+    /// edit can change and copying the others from `r.previous` ([`Mesher::remesh_cubes`]): only
+    /// the samples around the brush's reach are sampled. The same bytes as meshing the whole
+    /// chunk; false (nothing done) when the previous mesh cannot be reused.
+    fn remesh_around(&self, grid: &ChunkGrid, r: &Reuse, scratch: &mut ChunkScratch, out: &mut ChunkMesh) -> bool {
+        let p = grid.padded;
+        // The box of samples the brush can change (none for paint).
+        let mut changed: Option<([usize; 3], [usize; 3])> = None;
+        if r.op.shapes() {
+            for b in 0..p {
+                for a in 0..p {
+                    let Some((lo, hi)) = r.op.column_span(grid.dirs[b * p + a]) else {
+                        continue;
+                    };
+                    let (c0, c1) = (
+                        grid.radii.partition_point(|x| *x < lo),
+                        grid.radii.partition_point(|x| *x <= hi),
+                    );
+                    if c0 >= c1 {
+                        continue;
+                    }
+                    let (l, h) = changed.get_or_insert(([a, b, c0], [a, b, c1 - 1]));
+                    *l = [l[0].min(a), l[1].min(b), l[2].min(c0)];
+                    *h = [h[0].max(a), h[1].max(b), h[2].max(c1 - 1)];
+                }
+            }
+        }
+        let region = changed.and_then(|(lo, hi)| CubeBox::around_samples(lo, hi, grid.tiles));
+        scratch.densities.clear();
+        scratch.densities.resize(grid.sample_count(), f32::NAN);
+        if let Some(region) = region {
+            let (lo, hi) = region.samples();
+            let dirs: Vec<DVec3> = (lo[1]..=hi[1])
+                .flat_map(|b| (lo[0]..=hi[0]).map(move |a| grid.dirs[b * p + a]))
+                .collect();
+            let radii = &grid.radii[lo[2]..=hi[2]];
+            let mut batch = vec![0.0f32; dirs.len() * radii.len()];
+            // Batches give every sample the bits of the whole chunk's batch.
+            self.density.sample_shell(&dirs, radii, &mut batch);
+            let depth = self.layout.depth_tiles();
+            let mut values = batch.into_iter();
+            for c in lo[2]..=hi[2] {
+                let k = grid.k0 + (c as i64 - 1) * grid.stride;
+                for b in lo[1]..=hi[1] {
+                    for a in lo[0]..=hi[0] {
+                        let d = values.next().expect("one value per sample of the box");
+                        scratch.densities[grid.index(a, b, c)] = close_sample(k, depth, d);
+                    }
+                }
+            }
+        }
+        scratch.columns.clear();
+        scratch
+            .mesher
+            .remesh_cubes(grid, &scratch.densities, r.previous, region, out, &mut scratch.copied)
     }
 
     /// The (edited) density batch of a chunk into `out`: [`Planet::density`]'s batch, through the
@@ -482,6 +593,24 @@ impl Planet {
             self.shade(out, None, None);
             return;
         }
+        // The sides to close, and the coarser neighbour across each.
+        let closing: Vec<(ChunkSide, ChunkKey)> = if self.layout.n_t().is_multiple_of(2) {
+            coarser
+                .sides()
+                .filter_map(|side| {
+                    let y = self.layout.neighbour(&key, side, key.level.checked_add(1)?)?;
+                    // Across a side shared with a sibling the region is the chunk's own parent,
+                    // never a coarser leaf: nothing to close.
+                    (y != key.parent()).then_some((side, y))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        if closing.is_empty() && reuse.is_some() {
+            // No transition patches: the plain pipeline, which can remesh around the edit.
+            return self.mesh_chunk(key, scratch, out, reuse);
+        }
         let grid = ChunkGrid::new(&self.layout, key);
         if !self.may_hold_surface(&key) {
             out.clear();
@@ -492,19 +621,10 @@ impl Planet {
         scratch.densities.resize(grid.sample_count(), 0.0);
         self.sample(key, &grid, &mut scratch.densities, Some(&mut scratch.columns));
         close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
-        let sides: Vec<(ChunkSide, Vec<DVec3>)> = if self.layout.n_t().is_multiple_of(2) {
-            coarser
-                .sides()
-                .filter_map(|side| {
-                    let y = self.layout.neighbour(&key, side, key.level.checked_add(1)?)?;
-                    // Across a side shared with a sibling the region is the chunk's own parent,
-                    // never a coarser leaf: nothing to close.
-                    (y != key.parent()).then(|| (side, self.coarse_gradients(&grid, side, y)))
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let sides: Vec<(ChunkSide, Vec<DVec3>)> = closing
+            .into_iter()
+            .map(|(side, y)| (side, self.coarse_gradients(&grid, side, y)))
+            .collect();
         let transitions: Vec<Transition> = sides
             .iter()
             .map(|(side, g)| Transition {
@@ -517,10 +637,17 @@ impl Planet {
             .mesh_with_transitions(&grid, &scratch.densities, &transitions, out);
         let edges = GridEdges {
             grid: &grid,
-            samples: scratch.mesher.vertex_edges(),
             columns: &scratch.columns,
         };
-        self.shade(out, Some(edges), reuse.map(|r| (r, &mut scratch.previous)));
+        self.shade(
+            out,
+            Some(edges),
+            reuse.map(|r| Reused {
+                reuse: r,
+                index: &mut scratch.previous,
+                copied: None,
+            }),
+        );
     }
 
     /// Meshes a chunk of any level with its seams closed toward coarser neighbours (allocating
@@ -716,7 +843,7 @@ impl Planet {
     /// With `edges` (a marching-cubes mesh) the shader reads the chunk's columns at each vertex's
     /// edge ([`pmc_density::presets::Shader::shade_edges`]); without (a height-field mesh) it
     /// shades the points, which lie on the surface.
-    fn shade(&self, m: &mut ChunkMesh, edges: Option<GridEdges>, reuse: Option<(Reuse, &mut EdgeIndex)>) {
+    fn shade(&self, m: &mut ChunkMesh, edges: Option<GridEdges>, reuse: Option<Reused>) {
         let datum = self.datum_radius();
         let sea = self.terrain.sea_radius;
         let paints = self.paints_for(m);
@@ -725,18 +852,35 @@ impl Planet {
         m.water_depths.reserve(n);
         m.colors.reserve(n);
         m.materials.reserve(n);
-        let reuse = reuse.filter(|(r, _)| r.previous.origin == m.origin && r.previous.has_attributes());
-        let reuse = reuse.map(|(r, index)| {
+        let reuse = reuse.filter(|u| u.reuse.previous.origin == m.origin && u.reuse.previous.has_attributes());
+        let reuse = reuse.map(|u| {
+            let (r, index) = (u.reuse, u.index);
+            let copied = u.copied.filter(|c| c.len() == n);
             index.clear();
+            // A vertex copied from the previous mesh is that vertex; a vertex marched anew can
+            // only be one the copies left (an edge holds one vertex).
+            let mut taken = vec![false; r.previous.vertex_count()];
+            for &j in copied.unwrap_or_default() {
+                if let Some(t) = taken.get_mut(j as usize) {
+                    *t = true;
+                }
+            }
             index.reserve(r.previous.edge_keys.len());
-            index.extend(r.previous.edge_keys.iter().enumerate().map(|(j, k)| (*k, j as u32)));
-            (r, &*index)
+            index.extend(
+                r.previous
+                    .edge_keys
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| !taken[*j])
+                    .map(|(j, k)| (*k, j as u32)),
+            );
+            (r, &*index, copied)
         });
         // Vertices unchanged by the edit take the previous mesh's attributes; the others are
         // shaded in one batch.
         let previous: Vec<Option<usize>> = match &reuse {
             None => Vec::new(),
-            Some((r, index)) => (0..n)
+            Some((r, index, copied)) => (0..n)
                 .map(|i| {
                     let same = |j: &u32| {
                         let j = *j as usize;
@@ -745,10 +889,11 @@ impl Planet {
                             && bits(r.previous.normals[j]) == bits(m.normals[i])
                     };
                     let outside = (m.world_position(i) - r.op.center).length() >= r.op.reach();
-                    index
-                        .get(&m.edge_keys[i])
-                        .filter(|j| outside && same(j))
-                        .map(|j| *j as usize)
+                    let candidate = match copied.map(|c| c[i]) {
+                        Some(j) if j != u32::MAX => Some(j),
+                        _ => index.get(&m.edge_keys[i]).copied(),
+                    };
+                    candidate.filter(|j| outside && same(j)).map(|j| j as usize)
                 })
                 .collect(),
         };
@@ -757,7 +902,7 @@ impl Planet {
         let points: Vec<DVec3> = todo.iter().map(|&i| m.world_position(i)).collect();
         let normals: Vec<DVec3> = todo.iter().map(|&i| DVec3::from(m.normals[i].map(f64::from))).collect();
         let mut shades = Vec::with_capacity(points.len());
-        match edges {
+        match edges.filter(|_| m.vertex_edges.len() == n) {
             Some(e) => {
                 // Where each vertex lies on its edge is taken from its stored position, so a
                 // vertex whose position and edge are unchanged gets the same shade (what reusing
@@ -765,7 +910,7 @@ impl Planet {
                 let at: Vec<VertexEdge> = todo
                     .iter()
                     .zip(&points)
-                    .map(|(&i, p)| e.grid.vertex_edge(e.samples[i], *p))
+                    .map(|(&i, p)| e.grid.vertex_edge(m.vertex_edges[i], *p))
                     .collect();
                 let vertices = EdgeVertices {
                     points: &points,
@@ -781,7 +926,7 @@ impl Planet {
         }
         let mut shaded = points.iter().zip(shades);
         for i in 0..n {
-            if let (Some(j), Some((r, _))) = (reused(i), &reuse) {
+            if let (Some(j), Some((r, _, _))) = (reused(i), &reuse) {
                 let prev = r.previous;
                 m.heights.push(prev.heights[j]);
                 m.water_depths.push(prev.water_depths[j]);

@@ -203,7 +203,9 @@ fn mesh_bytes(m: &ChunkMesh) -> u64 {
         + size_of_val(m.heights.as_slice())
         + size_of_val(m.water_depths.as_slice())
         + size_of_val(m.colors.as_slice())
-        + size_of_val(m.materials.as_slice());
+        + size_of_val(m.materials.as_slice())
+        + size_of_val(m.vertex_edges.as_slice())
+        + size_of_val(m.cube_runs.as_slice());
     (buffers + std::mem::size_of::<ChunkMesh>()) as u64
 }
 
