@@ -11,15 +11,17 @@
 //!   meet: it touches 8 chunks, the most a 16 m brush touches away from cube corners.
 //!
 //! Each brush is measured four ways: `remesh` without a base cache (the terrain noise sampled again
-//! for every chunk), `remesh_reusing` without a cache (shading anew only the vertices the edit
-//! moved; same bytes), and `remesh_reusing` with the planet's base density cache
-//! (`Planet::with_base_cache`) warm, the steady state of a user editing (the chunks around the
-//! user were meshed already), and cold (a fresh cache every iteration: sampled and stored).
+//! for every chunk), `remesh_reusing` without a cache (from the meshes before the edit: only the
+//! cubes around the brush marched again, from a box of samples, the rest copied, and only the
+//! vertices the edit moved shaded anew; same bytes), and `remesh_reusing` with the planet's base
+//! density cache (`Planet::with_base_cache`) warm, the steady state of a user editing (the chunks
+//! around the user were meshed already), and cold (a fresh, empty cache every iteration).
 //!
-//! For the 16 m brushes the breakdown benchmarks split the work over the same chunks: finding
-//! them, the base terrain's density batch, the batch with the edit applied, density plus shell
-//! plus meshing without shading; and, on the cached path, copying the cached base batches, applying
-//! the edit over them, and shell plus meshing from the edited batches.
+//! For the 16 m brushes the breakdown benchmarks split the work of meshing whole chunks (as
+//! `remesh` does) over the same chunks: finding them, the base terrain's density batch, the batch
+//! with the edit applied, density plus shell plus meshing without shading; and, on the cached
+//! path, copying the cached base batches, applying the edit over them, and shell plus meshing
+//! from the edited batches.
 use criterion::{criterion_group, criterion_main, Criterion};
 use pmc_bench::{chunk_corner, default_planet, nearest_column, surface_along, surface_point};
 use pmc_density::Density;

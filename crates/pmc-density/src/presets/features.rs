@@ -245,45 +245,42 @@ pub(crate) fn carved_voxels<C>(
     let (seed_a, seed_b) = caves.seeds();
     let (slope, neg_ts) = (caves.slope, caves.neg_ts);
     for (k, &rk) in radii.iter().enumerate() {
-        // r = |dir * rk| as glam computes it, `h - r`, and whether an overhang window holds it.
+        // One pass: r = |dir * rk| as glam computes it, `h - r`, whether an overhang window
+        // holds it (flag bit 0), the caves' bound without noise `-t S + P(r)` and whether it is
+        // below `h - r` (bit 1; tested again where a displacement moves `h - r`).
         wide(|| {
-            let (rs, d0, flags) = (&mut rs[..n], &mut d0[..n], &mut flags[..n]);
+            let (rs, d0, pen, flags) = (&mut rs[..n], &mut d0[..n], &mut pen[..n], &mut flags[..n]);
             let (dx, dy, dz, h, reach) = (&dx[..n], &dy[..n], &dz[..n], &h[..n], &reach[..n]);
+            let (mid, half) = (&mid[..n], &half[..n]);
             for d in 0..n {
                 let (x, y, z) = (dx[d] * rk, dy[d] * rk, dz[d] * rk);
                 let r = (x * x + y * y + z * z).sqrt();
                 let b = h[d] - r;
+                let p = slope * ((r - mid[d]).abs() - half[d]).max(0.0);
                 rs[d] = r;
                 d0[d] = b;
-                flags[d] = !(b.abs() >= reach[d]) as u8;
+                pen[d] = p;
+                flags[d] = (!(b.abs() >= reach[d]) as u8) | (((neg_ts + p < b) as u8) << 1);
             }
         });
         if let Some(o) = overhang {
-            flagged(&flags, &mut at);
+            flagged(&flags, 1, &mut at);
             noise.set_points(at.len(), |j| {
                 let d = at[j] as usize;
                 o.point(dirs[d], rs[d])
             });
             if !at.is_empty() {
                 noise.values(o.seed(), &mut n1);
-                // The window's weight `a w` only where it holds the voxel (a division each).
+                // The window's weight `a w` only where it holds the voxel (a division each), and
+                // the caves' test again at the displaced value.
                 for (&d, v) in at.iter().zip(&n1) {
                     let d = d as usize;
                     d0[d] += Overhang::weight(amp[d], reach[d], d0[d].abs()) * v;
+                    flags[d] = 1 | (((neg_ts + pen[d] < d0[d]) as u8) << 1);
                 }
             }
         }
-        // The caves' bound without noise, `-t S + P(r)`, and whether it is below `d0`.
-        wide(|| {
-            let (pen, flags) = (&mut pen[..n], &mut flags[..n]);
-            let (rs, d0, mid, half) = (&rs[..n], &d0[..n], &mid[..n], &half[..n]);
-            for d in 0..n {
-                let p = slope * ((rs[d] - mid[d]).abs() - half[d]).max(0.0);
-                pen[d] = p;
-                flags[d] = (neg_ts + p < d0[d]) as u8;
-            }
-        });
-        flagged(&flags, &mut at);
+        flagged(&flags, 2, &mut at);
         noise.set_points(at.len(), |j| {
             let d = at[j] as usize;
             caves.point(dirs[d], rs[d])
@@ -302,31 +299,32 @@ pub(crate) fn carved_voxels<C>(
     }
 }
 
-/// The indices of the nonzero flags into `idx` (cleared first), in order: eight zero flags
-/// are skipped at a time, and a group of eight with any flag set is compacted without a branch
-/// per flag (the flags' pattern is irregular, so per-flag branches mispredict).
+/// The indices of the flags with a bit of `mask` set into `idx` (cleared first), in order:
+/// eight flags without one are skipped at a time, and a group of eight with any is compacted
+/// without a branch per flag (the flags' pattern is irregular, so per-flag branches mispredict).
 #[inline]
-fn flagged(flags: &[u8], idx: &mut Vec<u32>) {
+fn flagged(flags: &[u8], mask: u8, idx: &mut Vec<u32>) {
     idx.clear();
     idx.resize(flags.len() + 8, 0);
     let mut m = 0;
+    let word_mask = u64::from_le_bytes([mask; 8]);
     let mut chunks = flags.chunks_exact(8);
     for (c, eight) in chunks.by_ref().enumerate() {
         let word = u64::from_le_bytes(eight.try_into().expect("eight flags"));
-        if word != 0 {
+        if word & word_mask != 0 {
             // `m + 8 <= c * 8 + 8 <= idx.len()`: the eight stores stay inside.
             let slots = &mut idx[m..m + 8];
             let mut k = 0;
             for (j, &b) in eight.iter().enumerate() {
                 slots[k] = (c * 8 + j) as u32;
-                k += usize::from(b != 0);
+                k += usize::from(b & mask != 0);
             }
             m += k;
         }
     }
     let start = flags.len() / 8 * 8;
     for (j, &b) in chunks.remainder().iter().enumerate() {
-        if b != 0 {
+        if b & mask != 0 {
             idx[m] = (start + j) as u32;
             m += 1;
         }
