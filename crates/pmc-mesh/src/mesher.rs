@@ -298,7 +298,7 @@ pub(crate) struct Ctx<'a> {
 
 impl Ctx<'_> {
     /// Emits the triangles of one cube: each cut edge's vertex is looked up once.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn emit_cube(&mut self, tables: &crate::tables::McTables, case: u8, a: usize, b: usize, c: usize) {
         let mut verts = [0u32; 12];
         let mut mask = tables.edge_masks[case as usize];
@@ -315,7 +315,7 @@ impl Ctx<'_> {
     }
 
     /// The vertex on cube edge `e` of the cube whose lowest corner is padded voxel `(a, b, c)`.
-    #[inline]
+    #[inline(always)]
     fn vertex(&mut self, a: usize, b: usize, c: usize, e: u8) -> u32 {
         let (lo, _) = EDGE_CORNERS[e as usize];
         let o = corner_offset(lo);
@@ -324,7 +324,7 @@ impl Ctx<'_> {
     }
 
     /// The vertex on the grid edge from padded voxel `v` one step along `axis` (created once).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn edge_vertex(&mut self, v: (usize, usize, usize), axis: usize) -> u32 {
         let (va, vb, vc) = v;
         let vi = self.grid.index(va, vb, vc);
