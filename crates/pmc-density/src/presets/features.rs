@@ -242,6 +242,8 @@ pub(crate) fn carved_voxels<C>(
     }
     let mut flags = vec![0u8; n];
     let (mut noise, mut at, mut n1, mut n2) = (NoiseBatch::default(), Vec::<u32>::new(), Vec::new(), Vec::new());
+    // The gathered amplitudes, reaches and values of the voxels an overhang window holds.
+    let (mut wa, mut wr, mut wz) = (Vec::<f64>::new(), Vec::<f64>::new(), Vec::<f64>::new());
     let (seed_a, seed_b) = caves.seeds();
     let (slope, neg_ts) = (caves.slope, caves.neg_ts);
     for (k, &rk) in radii.iter().enumerate() {
@@ -271,11 +273,23 @@ pub(crate) fn carved_voxels<C>(
             });
             if !at.is_empty() {
                 noise.values(o.seed(), &mut n1);
-                // The window's weight `a w` only where it holds the voxel (a division each), and
-                // the caves' test again at the displaced value.
-                for (&d, v) in at.iter().zip(&n1) {
+                // The window's weight `a w` only where it holds the voxel (a division each, on
+                // the gathered values eight lanes wide), and the caves' test again at the
+                // displaced value.
+                let m = at.len();
+                for (slot, src) in [(&mut wa, &amp[..]), (&mut wr, &reach[..]), (&mut wz, &d0[..])] {
+                    slot.clear();
+                    slot.extend(at.iter().map(|&d| src[d as usize]));
+                }
+                wide(|| {
+                    let (wa, wr, wz, n1) = (&wa[..m], &wr[..m], &mut wz[..m], &n1[..m]);
+                    for j in 0..m {
+                        wz[j] = Overhang::weight(wa[j], wr[j], wz[j].abs()) * n1[j];
+                    }
+                });
+                for (&d, shift) in at.iter().zip(&wz) {
                     let d = d as usize;
-                    d0[d] += Overhang::weight(amp[d], reach[d], d0[d].abs()) * v;
+                    d0[d] += shift;
                     flags[d] = 1 | (((neg_ts + pen[d] < d0[d]) as u8) << 1);
                 }
             }
