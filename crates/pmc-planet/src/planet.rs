@@ -414,16 +414,7 @@ impl Planet {
         }
         if let Some(r) = &reuse {
             if self.remesh_around(grid, r, scratch, out) {
-                let edges = GridEdges {
-                    grid,
-                    columns: &scratch.columns,
-                };
-                let reuse = reuse.map(|r| Reused {
-                    reuse: r,
-                    index: &mut scratch.previous,
-                    copied: Some(&scratch.copied),
-                });
-                self.shade(out, Some(edges), reuse);
+                self.shade_grid(out, grid, scratch, reuse, true);
                 return;
             }
         }
@@ -431,19 +422,30 @@ impl Planet {
         self.sample(key, grid, &mut scratch.densities, Some(&mut scratch.columns));
         close_shell(grid, self.layout.depth_tiles(), &mut scratch.densities);
         scratch.mesher.mesh(grid, &scratch.densities, out);
+        self.shade_grid(out, grid, scratch, reuse, false);
+    }
+
+    /// [`Planet::shade`] for a marching-cubes mesh of `grid`, from the columns the density batch
+    /// kept in `scratch`, reusing the attributes of `reuse`'s previous mesh (through the copy
+    /// map when the mesh was `remeshed` around the edit).
+    fn shade_grid(
+        &self,
+        out: &mut ChunkMesh,
+        grid: &ChunkGrid,
+        scratch: &mut ChunkScratch,
+        reuse: Option<Reuse>,
+        remeshed: bool,
+    ) {
         let edges = GridEdges {
             grid,
             columns: &scratch.columns,
         };
-        self.shade(
-            out,
-            Some(edges),
-            reuse.map(|r| Reused {
-                reuse: r,
-                index: &mut scratch.previous,
-                copied: None,
-            }),
-        );
+        let reuse = reuse.map(|r| Reused {
+            reuse: r,
+            index: &mut scratch.previous,
+            copied: remeshed.then_some(&scratch.copied[..]),
+        });
+        self.shade(out, Some(edges), reuse);
     }
 
     /// Meshes the chunk of `grid` after the edit `r.op` by marching again only the cubes the
@@ -635,19 +637,7 @@ impl Planet {
         scratch
             .mesher
             .mesh_with_transitions(&grid, &scratch.densities, &transitions, out);
-        let edges = GridEdges {
-            grid: &grid,
-            columns: &scratch.columns,
-        };
-        self.shade(
-            out,
-            Some(edges),
-            reuse.map(|r| Reused {
-                reuse: r,
-                index: &mut scratch.previous,
-                copied: None,
-            }),
-        );
+        self.shade_grid(out, &grid, scratch, reuse, false);
     }
 
     /// Meshes a chunk of any level with its seams closed toward coarser neighbours (allocating
