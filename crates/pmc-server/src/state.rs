@@ -85,8 +85,9 @@ pub struct JobStats {
     /// Jobs dropped from the queue without being generated since start, because every request
     /// waiting for them went away (the clients hung up) before a worker took them.
     pub dropped: u64,
-    /// Jobs since start that meshed a chunk of the world again after an edit reusing the shading
-    /// of its mesh before the edit (for the vertices the edit did not touch).
+    /// Jobs since start that meshed a chunk of the world again after an edit from its mesh before
+    /// the edit: the shading of the vertices the edit did not touch and, without transition
+    /// patches, the cubes it cannot change.
     pub reused_shading: u64,
 }
 
