@@ -62,13 +62,15 @@ pub trait Density: Send + Sync {
 }
 
 /// What a density batch computed once per direction (a column model's columns), kept with the
-/// directions it belongs to ([`Density::sample_shell_keeping`]).
+/// directions it belongs to and the model that computed it ([`Density::sample_shell_keeping`]).
 ///
-/// Only a reader of the same model and of exactly the same directions gets the values back
-/// ([`ShellColumns::get`]): anything else finds it empty, and computes the columns itself. So
+/// A reader gets the values back only for the same model (its `owner` key: the address of the
+/// model the density and the shader share), exactly the same directions and the same type
+/// ([`ShellColumns::get`]); anything else finds nothing and computes the columns itself. So
 /// keeping columns saves work and never changes a result.
 #[derive(Default)]
 pub struct ShellColumns {
+    owner: usize,
     dirs: Vec<DVec3>,
     values: Option<Box<dyn Any + Send + Sync>>,
 }
@@ -94,11 +96,12 @@ impl ShellColumns {
         self.dirs.is_empty()
     }
 
-    /// The values kept for `dirs` as a slice of `T` (one per direction), if these are exactly the
-    /// directions they were computed for (bit for bit) and they are of type `T`.
-    pub fn get<T: 'static>(&self, dirs: &[DVec3]) -> Option<&[T]> {
+    /// The values `owner` kept for `dirs` as a slice of `T` (one per direction), if these are
+    /// exactly the directions they were computed for (bit for bit) and they are of type `T`.
+    pub fn get<T: 'static>(&self, owner: usize, dirs: &[DVec3]) -> Option<&[T]> {
         let values = self.values.as_ref()?.downcast_ref::<Vec<T>>()?;
-        let same = self.dirs.len() == dirs.len()
+        let same = owner == self.owner
+            && self.dirs.len() == dirs.len()
             && self
                 .dirs
                 .iter()
@@ -107,15 +110,18 @@ impl ShellColumns {
         (same && values.len() == dirs.len()).then_some(values.as_slice())
     }
 
-    /// Keeps values of type `T` for `dirs`: `fill` writes them into an empty vector (reusing the
-    /// previous allocation when its type matches) and must push one per direction.
-    pub fn keep<T: Send + Sync + 'static>(&mut self, dirs: &[DVec3], fill: impl FnOnce(&mut Vec<T>)) {
+    /// Keeps values of type `T` for `dirs`, computed by the model `owner` names (a key unique
+    /// among the models alive, such as the address of the model shared by a terrain's density
+    /// and shader): `fill` writes them into an empty vector (reusing the previous allocation
+    /// when its type matches) and must push one per direction.
+    pub fn keep<T: Send + Sync + 'static>(&mut self, owner: usize, dirs: &[DVec3], fill: impl FnOnce(&mut Vec<T>)) {
         let mut values: Box<Vec<T>> = match self.values.take().map(|v| v.downcast::<Vec<T>>()) {
             Some(Ok(v)) => v,
             _ => Box::default(),
         };
         values.clear();
         fill(&mut values);
+        self.owner = owner;
         self.dirs.clear();
         self.dirs.extend_from_slice(dirs);
         self.values = Some(values);
@@ -253,22 +259,23 @@ mod tests {
     }
 
     #[test]
-    fn kept_columns_come_back_only_for_the_same_directions_and_type() {
+    fn kept_columns_come_back_only_for_the_same_model_directions_and_type() {
         let dirs = [DVec3::X, DVec3::Y];
         let mut kept = ShellColumns::default();
-        assert!(kept.is_empty() && kept.get::<f64>(&dirs).is_none());
-        kept.keep(&dirs, |v: &mut Vec<f64>| v.extend([1.0, 2.0]));
-        assert_eq!(kept.get::<f64>(&dirs), Some(&[1.0, 2.0][..]));
-        assert!(kept.get::<f32>(&dirs).is_none(), "another type");
-        assert!(kept.get::<f64>(&[DVec3::X]).is_none(), "fewer directions");
-        assert!(kept.get::<f64>(&[DVec3::X, DVec3::Z]).is_none(), "other directions");
+        assert!(kept.is_empty() && kept.get::<f64>(7, &dirs).is_none());
+        kept.keep(7, &dirs, |v: &mut Vec<f64>| v.extend([1.0, 2.0]));
+        assert_eq!(kept.get::<f64>(7, &dirs), Some(&[1.0, 2.0][..]));
+        assert!(kept.get::<f64>(8, &dirs).is_none(), "another model");
+        assert!(kept.get::<f32>(7, &dirs).is_none(), "another type");
+        assert!(kept.get::<f64>(7, &[DVec3::X]).is_none(), "fewer directions");
+        assert!(kept.get::<f64>(7, &[DVec3::X, DVec3::Z]).is_none(), "other directions");
         let nudged = DVec3::new(f64::from_bits(1.0f64.to_bits() - 1), 0.0, 0.0);
-        assert!(kept.get::<f64>(&[nudged, DVec3::Y]).is_none(), "one bit off");
+        assert!(kept.get::<f64>(7, &[nudged, DVec3::Y]).is_none(), "one bit off");
         // A default batch keeps nothing; a keeper of the wrong count is never read.
         Sphere { radius: 1.0 }.sample_shell_keeping(&dirs, &[1.0], &mut [0.0; 2], &mut kept);
-        assert!(kept.is_empty() && kept.get::<f64>(&dirs).is_none());
-        kept.keep(&dirs, |v: &mut Vec<f64>| v.push(1.0));
-        assert!(kept.get::<f64>(&dirs).is_none(), "one value for two directions");
+        assert!(kept.is_empty() && kept.get::<f64>(7, &dirs).is_none());
+        kept.keep(7, &dirs, |v: &mut Vec<f64>| v.push(1.0));
+        assert!(kept.get::<f64>(7, &dirs).is_none(), "one value for two directions");
     }
 
     #[test]

@@ -59,8 +59,8 @@ pub struct ChunkScratch {
     densities: Vec<f32>,
     /// What the density batch kept per column, for the shader.
     columns: ShellColumns,
-    /// The grid of the last chunk meshed.
-    grid: Option<ChunkGrid>,
+    /// The grid of the last chunk meshed, with its layout (a scratch may serve several planets).
+    grid: Option<(Layout, ChunkGrid)>,
     /// Per vertex of a mesh remeshed around an edit, the previous mesh's vertex it was copied
     /// from (`u32::MAX`: marched anew).
     copied: Vec<u32>,
@@ -388,17 +388,20 @@ impl Planet {
         }
         let grid = self.grid_after(key, scratch.grid.take());
         self.mesh_chunk_in(&grid, scratch, out, reuse);
-        scratch.grid = Some(grid);
+        scratch.grid = Some((self.layout, grid));
     }
 
-    /// The sample grid of `key`: `last` (the grid of the chunk meshed before) moved to `key`'s
-    /// depth when it has the same footprint (its directions copied, not computed again: the
-    /// chunks an edit touches come in depth pairs, and a planet's chunks in depth order), else
-    /// a new one. The same grid either way ([`ChunkGrid::at_depth`]).
-    fn grid_after(&self, key: ChunkKey, last: Option<ChunkGrid>) -> ChunkGrid {
+    /// The sample grid of `key`: `last` (the grid of the chunk meshed before, and its layout)
+    /// moved to `key`'s depth when it is of this planet's layout and has the same footprint (its
+    /// directions copied, not computed again: the chunks an edit touches come in depth pairs,
+    /// and a planet's chunks in depth order), else a new one. The same grid either way
+    /// ([`ChunkGrid::at_depth`]).
+    fn grid_after(&self, key: ChunkKey, last: Option<(Layout, ChunkGrid)>) -> ChunkGrid {
         match last {
-            Some(g) if g.key == key => g,
-            Some(g) if g.key == ChunkKey { k: g.key.k, ..key } => g.at_depth(&self.layout, key.k),
+            Some((l, g)) if l == self.layout && g.key == key => g,
+            Some((l, g)) if l == self.layout && g.key == ChunkKey { k: g.key.k, ..key } => {
+                g.at_depth(&self.layout, key.k)
+            }
             _ => ChunkGrid::new(&self.layout, key),
         }
     }

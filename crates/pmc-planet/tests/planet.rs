@@ -4,7 +4,7 @@
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use pmc_mesh::{ChunkMesh, WeldedMesh};
-use pmc_planet::{Planet, PresetKind};
+use pmc_planet::{ChunkScratch, Planet, PresetKind};
 use proptest::prelude::*;
 
 fn generate(planet: &Planet, threads: usize) -> Vec<ChunkMesh> {
@@ -175,4 +175,24 @@ fn shading_from_edge_columns_keeps_the_point_shaders_materials() {
         agree > 0.999,
         "{same} of {total} vertices keep their material ({agree})"
     );
+}
+
+/// A chunk scratch keeps the last chunk's grid to move it to the next chunk of the same
+/// footprint, and one scratch may serve planets of different layouts (the remesh scratch is one
+/// per thread): a grid kept from another layout with the same chunk key must not be reused.
+#[test]
+fn a_scratch_shared_by_planets_of_two_layouts_kept_the_other_layouts_grid() {
+    let a = Planet::new(PresetKind::Earthlike, 3, Layout::new(2, 8, 60.0, 1.0, 2).unwrap());
+    let b = Planet::new(PresetKind::Earthlike, 3, Layout::new(2, 8, 90.0, 1.5, 2).unwrap());
+    let mut scratch = ChunkScratch::default();
+    let (mut m, mut surfaces) = (ChunkMesh::default(), 0);
+    for key in a.layout().chunks(0) {
+        for (first, second) in [(&a, &b), (&b, &a)] {
+            first.chunk_mesh_into(key, &mut scratch, &mut m);
+            second.chunk_mesh_into(key, &mut scratch, &mut m);
+            assert!(m == second.chunk_mesh(key), "{key}");
+            surfaces += usize::from(!m.is_empty());
+        }
+    }
+    assert!(surfaces > 10, "{surfaces} chunks with a surface");
 }

@@ -16,7 +16,8 @@
 //! | caves              | band from sea level + `l_d` to 2.5 `l_d` under the surface, at most 0.14 T deep; the roof opens in places (cave mouths) | tubes about 2 tiles wide and 3 `l_d` tall, about 12 tiles apart |
 
 use super::features::{
-    carved_voxels, lerp, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales, Spaghetti,
+    carved_voxels, lerp, model_key, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales,
+    Spaghetti,
 };
 use super::shading::{Material, Palette};
 use super::{EdgeVertices, PresetKind, Shade, Shader, Terrain};
@@ -495,7 +496,8 @@ impl Shader for EarthShader {
     fn shade_edges(&self, v: &EdgeVertices<'_>, out: &mut Vec<Shade>) {
         v.check();
         let computed;
-        let (cols, slot): (&[EarthColumn], Option<Vec<u32>>) = match v.columns.get::<EarthColumn>(v.dirs) {
+        let kept = v.columns.get::<EarthColumn>(model_key(&self.model), v.dirs);
+        let (cols, slot): (&[EarthColumn], Option<Vec<u32>>) = match kept {
             Some(cols) => (cols, None),
             None => {
                 // Only the directions some edge ends at, each once.
@@ -607,6 +609,10 @@ mod tests {
         };
         let from_batch = shade(&kept);
         assert_eq!(from_batch, shade(&ShellColumns::default()));
+        // Columns another terrain kept over the same directions are not read.
+        let (other, _) = terrain(4);
+        other.density.sample_shell_keeping(&dirs, &[m.sea], &mut out, &mut kept);
+        assert_eq!(from_batch, shade(&kept));
         let materials: std::collections::HashSet<u8> = from_batch.iter().map(|s| s.material).collect();
         assert!(materials.len() >= 4, "{materials:?}");
     }

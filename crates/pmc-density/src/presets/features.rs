@@ -97,6 +97,12 @@ pub(crate) trait ColumnModel: Send + Sync + 'static {
     fn bounds(&self) -> (f64, f64);
 }
 
+/// The key of a model shared by a terrain's density and shader, for [`ShellColumns`]: its
+/// address, unique among the models alive.
+pub(crate) fn model_key<M>(model: &Arc<M>) -> usize {
+    Arc::as_ptr(model) as *const () as usize
+}
+
 /// A [`ColumnModel`] as a [`Density`]: the batch call evaluates each column once.
 ///
 /// Point calls normalise `p` to find the column; the batch uses the given unit directions. Both
@@ -123,8 +129,9 @@ impl<M: ColumnModel> Density for ColumnDensity<M> {
     /// The batch, keeping its columns (`Vec<M::Column>`, one per direction) for the shader.
     fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
         assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
-        columns.keep(dirs, |cols| self.0.columns(dirs, cols));
-        let cols = columns.get::<M::Column>(dirs).expect("the columns just kept");
+        let owner = model_key(&self.0);
+        columns.keep(owner, dirs, |cols| self.0.columns(dirs, cols));
+        let cols = columns.get::<M::Column>(owner, dirs).expect("the columns just kept");
         self.0.voxels(cols, dirs, radii, out);
     }
 
