@@ -248,7 +248,7 @@ pub(crate) fn carved_voxels<C>(
         (mid[d], half[d]) = (band.mid, band.half);
     }
     let mut flags = vec![0u8; n];
-    let (mut noise, mut at, mut n1, mut n2) = (NoiseBatch::default(), Vec::<u32>::new(), Vec::new(), Vec::new());
+    let (mut noise, mut slots, mut n1, mut n2) = (NoiseBatch::default(), Vec::<u32>::new(), Vec::new(), Vec::new());
     // The gathered amplitudes, reaches and values of the voxels an overhang window holds.
     let (mut wa, mut wr, mut wz) = (Vec::<f64>::new(), Vec::<f64>::new(), Vec::<f64>::new());
     let (seed_a, seed_b) = caves.seeds();
@@ -273,7 +273,7 @@ pub(crate) fn carved_voxels<C>(
             }
         });
         if let Some(o) = overhang {
-            flagged(&flags, 1, &mut at);
+            let at = flagged(&flags, 1, &mut slots);
             noise.set_points(at.len(), |j| {
                 let d = at[j] as usize;
                 o.point(dirs[d], rs[d])
@@ -301,7 +301,7 @@ pub(crate) fn carved_voxels<C>(
                 }
             }
         }
-        flagged(&flags, 2, &mut at);
+        let at = flagged(&flags, 2, &mut slots);
         noise.set_points(at.len(), |j| {
             let d = at[j] as usize;
             caves.point(dirs[d], rs[d])
@@ -320,13 +320,16 @@ pub(crate) fn carved_voxels<C>(
     }
 }
 
-/// The indices of the flags with a bit of `mask` set into `idx` (cleared first), in order:
-/// eight flags without one are skipped at a time, and a group of eight with any is compacted
-/// without a branch per flag (the flags' pattern is irregular, so per-flag branches mispredict).
+/// The indices of the flags with a bit of `mask` set, in order, written into `slots` (grown to
+/// `flags.len() + 8` once and not cleared: every index returned is written first): eight flags
+/// without one are skipped at a time, and a group of eight with any is compacted without a
+/// branch per flag (the flags' pattern is irregular, so per-flag branches mispredict).
 #[inline]
-fn flagged(flags: &[u8], mask: u8, idx: &mut Vec<u32>) {
-    idx.clear();
-    idx.resize(flags.len() + 8, 0);
+fn flagged<'a>(flags: &[u8], mask: u8, slots: &'a mut Vec<u32>) -> &'a [u32] {
+    if slots.len() < flags.len() + 8 {
+        slots.resize(flags.len() + 8, 0);
+    }
+    let idx = &mut slots[..];
     let mut m = 0;
     let word_mask = u64::from_le_bytes([mask; 8]);
     let mut chunks = flags.chunks_exact(8);
@@ -334,10 +337,10 @@ fn flagged(flags: &[u8], mask: u8, idx: &mut Vec<u32>) {
         let word = u64::from_le_bytes(eight.try_into().expect("eight flags"));
         if word & word_mask != 0 {
             // `m + 8 <= c * 8 + 8 <= idx.len()`: the eight stores stay inside.
-            let slots = &mut idx[m..m + 8];
+            let group = &mut idx[m..m + 8];
             let mut k = 0;
             for (j, &b) in eight.iter().enumerate() {
-                slots[k] = (c * 8 + j) as u32;
+                group[k] = (c * 8 + j) as u32;
                 k += usize::from(b & mask != 0);
             }
             m += k;
@@ -350,7 +353,7 @@ fn flagged(flags: &[u8], mask: u8, idx: &mut Vec<u32>) {
             m += 1;
         }
     }
-    idx.truncate(m);
+    &slots[..m]
 }
 
 /// Mean gradient magnitude of [`gradient3`] per lattice unit (measured: 1.1), used to turn noise
