@@ -17,9 +17,9 @@ pub fn is_solid(d: f32) -> bool {
 /// meshing an empty or sparse chunk costs little more than reading its samples.
 #[derive(Debug, Default)]
 pub struct Mesher {
-    pub(crate) generation: u32,
+    generation: u32,
     /// Per padded voxel and axis: `(generation << 32) | vertex index`.
-    pub(crate) edge_cache: Vec<u64>,
+    edge_cache: Vec<u64>,
     /// Per padded voxel: generation of the cached gradient.
     grad_stamp: Vec<u32>,
     grad: Vec<DVec3>,
@@ -62,6 +62,20 @@ impl Mesher {
             let dr = grid.radii[(c + 1).min(p - 1)] - grid.radii[c.saturating_sub(1)];
             [1.0 / grid.radii[c], 1.0 / dr]
         }));
+    }
+
+    /// The vertex made on edge slot `slot` (padded voxel `* 3 +` axis) of the mesh being made,
+    /// if any.
+    #[inline(always)]
+    pub(crate) fn cached_vertex(&self, slot: usize) -> Option<u32> {
+        let cached = self.edge_cache[slot];
+        ((cached >> 32) as u32 == self.generation).then_some(cached as u32)
+    }
+
+    /// Records vertex `idx` as the one on edge slot `slot` of the mesh being made.
+    #[inline(always)]
+    pub(crate) fn cache_vertex(&mut self, slot: usize, idx: u32) {
+        self.edge_cache[slot] = (u64::from(self.generation) << 32) | u64::from(idx);
     }
 
     /// A mesher with empty caches (they grow to the first chunk's size).
@@ -205,21 +219,12 @@ fn march_plain(ctx: &mut Ctx<'_>, tables: &crate::tables::McTables) {
     if !has_sign_change(grid, ctx.densities) {
         return;
     }
-    let corner_index: [usize; 8] = std::array::from_fn(|c| {
-        let o = corner_offset(c as u8);
-        (o[2] * p + o[1]) * p + o[0]
-    });
+    let corners = corner_flat_offsets(p);
     for c in 1..=n {
         for b in 1..=n {
             let row = grid.index(0, b, c);
             for a in 1..=n {
-                let base = row + a;
-                let mut case = 0u8;
-                for (k, off) in corner_index.iter().enumerate() {
-                    if is_solid(ctx.densities[base + off]) {
-                        case |= 1 << k;
-                    }
-                }
+                let case = cube_case(ctx.densities, row + a, &corners);
                 if case == 0 || case == 255 {
                     continue;
                 }
@@ -227,6 +232,21 @@ fn march_plain(ctx: &mut Ctx<'_>, tables: &crate::tables::McTables) {
             }
         }
     }
+}
+
+/// The flat offsets of a cube's eight corners from its lowest, in a grid `p` samples wide.
+pub(crate) fn corner_flat_offsets(p: usize) -> [usize; 8] {
+    std::array::from_fn(|c| {
+        let o = corner_offset(c as u8);
+        (o[2] * p + o[1]) * p + o[0]
+    })
+}
+
+/// The case of the cube whose lowest corner is flat sample `base`: bit `k` set when corner `k`
+/// is solid.
+#[inline]
+pub(crate) fn cube_case(densities: &[f32], base: usize, corners: &[usize; 8]) -> u8 {
+    (0..8).fold(0u8, |m, k| m | (u8::from(is_solid(densities[base + corners[k]])) << k))
 }
 
 /// Whether the chunk's own (unpadded) samples hold both solid and air.
@@ -329,10 +349,8 @@ impl Ctx<'_> {
         let (va, vb, vc) = v;
         let vi = self.grid.index(va, vb, vc);
         let slot = vi * 3 + axis;
-        let gen = self.mesher.generation;
-        let cached = self.mesher.edge_cache[slot];
-        if (cached >> 32) as u32 == gen {
-            return cached as u32;
+        if let Some(idx) = self.mesher.cached_vertex(slot) {
+            return idx;
         }
         let (wa, wb, wc) = match axis {
             0 => (va + 1, vb, vc),
@@ -340,7 +358,7 @@ impl Ctx<'_> {
             _ => (va, vb, vc + 1),
         };
         let idx = self.make_vertex((va, vb, vc), (wa, wb, wc), axis);
-        self.mesher.edge_cache[slot] = (u64::from(gen) << 32) | u64::from(idx);
+        self.mesher.cache_vertex(slot, idx);
         idx
     }
 

@@ -3,8 +3,8 @@
 //! result is the same bytes as meshing the whole chunk again.
 
 use crate::chunk_mesh::ChunkMesh;
-use crate::mesher::{finish_normals, is_solid, Ctx, Mesher};
-use crate::tables::{corner_offset, EDGE_AXIS, EDGE_CORNERS, TABLES};
+use crate::mesher::{corner_flat_offsets, cube_case, finish_normals, Ctx, Mesher};
+use crate::tables::{EDGE_AXIS, EDGE_CORNERS, TABLES};
 use pmc_geometry::ChunkGrid;
 
 /// A box of a chunk's cubes, by the padded indices `(a, b, c)` of their lowest corners,
@@ -87,11 +87,7 @@ impl Mesher {
         self.start(grid, out);
         let p = grid.padded;
         let coords = |flat: usize| [flat % p, (flat / p) % p, flat / (p * p)];
-        // The flat offsets of a cube's eight corners from its lowest.
-        let corner_flat: [usize; 8] = std::array::from_fn(|k| {
-            let o = corner_offset(k as u8);
-            (o[2] * p + o[1]) * p + o[0]
-        });
+        let corner_flat = corner_flat_offsets(p);
         // The region's cut cubes (neither all solid nor all air), in the mesher's order.
         let mut fresh: Vec<(usize, u8)> = Vec::new();
         if let Some(r) = region {
@@ -99,9 +95,7 @@ impl Mesher {
                 for b in r.lo[1]..=r.hi[1] {
                     for a in r.lo[0]..=r.hi[0] {
                         let base = grid.index(a, b, c);
-                        let case = (0..8).fold(0u8, |m, k| {
-                            m | (u8::from(is_solid(densities[base + corner_flat[k]])) << k)
-                        });
+                        let case = cube_case(densities, base, &corner_flat);
                         if case != 0 && case != 255 {
                             fresh.push((base, case));
                         }
@@ -117,9 +111,8 @@ impl Mesher {
             out,
         };
         let n_prev = previous.vertex_count();
-        // Previous vertex -> new vertex, and the copies made (new, previous) for the normals.
+        // Previous vertex -> new vertex (and, in `copied_from`, new -> previous).
         let mut map = vec![u32::MAX; n_prev];
-        let mut copied: Vec<(u32, u32)> = Vec::new();
         let mut cube_verts: Vec<(u8, u32)> = Vec::with_capacity(12);
         let runs = &previous.cube_runs;
         let (mut pi, mut fi, mut start) = (0, 0, 0usize);
@@ -161,7 +154,7 @@ impl Mesher {
                 cube_verts.sort_unstable();
             }
             for &(_, j) in &cube_verts {
-                map[j as usize] = ctx.copy_vertex(previous, j as usize, edges[j as usize], &mut copied);
+                map[j as usize] = ctx.copy_vertex(previous, j as usize, edges[j as usize], copied_from);
             }
             ctx.out.indices.extend(tris.iter().map(|&j| map[j as usize]));
             let end = (ctx.out.indices.len() / 3) as u32;
@@ -170,9 +163,8 @@ impl Mesher {
         finish_normals(out);
         // Copied normals are final already (normalising them again could move a bit).
         copied_from.resize(out.vertex_count(), u32::MAX);
-        for (new, old) in copied {
-            out.normals[new as usize] = previous.normals[old as usize];
-            copied_from[new as usize] = old;
+        for (new, &old) in copied_from.iter().enumerate().filter(|(_, j)| **j != u32::MAX) {
+            out.normals[new] = previous.normals[old as usize];
         }
         true
     }
@@ -234,13 +226,11 @@ fn cube_edge(edge: Edge, cube: usize, corner_flat: &[usize; 8]) -> u8 {
 
 impl Ctx<'_> {
     /// Copies vertex `j` of `previous` (on `edge`) into the mesh, or finds it there already (a
-    /// marched cube made it): its new index.
-    fn copy_vertex(&mut self, previous: &ChunkMesh, j: usize, edge: Edge, copied: &mut Vec<(u32, u32)>) -> u32 {
+    /// marched cube made it): its new index, recorded in `copied_from` when it is a copy.
+    fn copy_vertex(&mut self, previous: &ChunkMesh, j: usize, edge: Edge, copied_from: &mut Vec<u32>) -> u32 {
         let slot = edge.lower * 3 + edge.axis;
-        let gen = self.mesher.generation;
-        let cached = self.mesher.edge_cache[slot];
-        if (cached >> 32) as u32 == gen {
-            return cached as u32;
+        if let Some(idx) = self.mesher.cached_vertex(slot) {
+            return idx;
         }
         let out = &mut *self.out;
         let idx = out.positions.len() as u32;
@@ -248,8 +238,10 @@ impl Ctx<'_> {
         out.normals.push(previous.normals[j]);
         out.edge_keys.push(previous.edge_keys[j]);
         out.vertex_edges.push(previous.vertex_edges[j]);
-        self.mesher.edge_cache[slot] = (u64::from(gen) << 32) | u64::from(idx);
-        copied.push((idx, j as u32));
+        self.mesher.cache_vertex(slot, idx);
+        // Vertices marched anew in between stay `u32::MAX`.
+        copied_from.resize(idx as usize, u32::MAX);
+        copied_from.push(j as u32);
         idx
     }
 }
