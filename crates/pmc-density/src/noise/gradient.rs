@@ -45,17 +45,39 @@ pub(super) const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
 ///
 /// Rounds with the `1.5 * 2^52` trick rather than a float-to-int conversion (which needs
 /// saturation fix-ups) or a libm `floor` call (targets without SSE4.1): a handful of branchless
-/// instructions. `x - round(x)` is exact (Sterbenz). Valid for `|x| < 2^51` (2e15 lattice cells,
-/// far beyond any planet). The fraction is 1 only when `x` is a hair below an integer, where the
-/// noise is continuous across the cell face, so the value is still right.
+/// instructions. `x - round(x)` is exact (Sterbenz). The rounding holds for `|x| < 2^51` (2e15
+/// lattice cells, far beyond any planet); beyond, where coordinates no longer resolve a cell, the
+/// cell is `floor(x)` converted as the vector kernel's instruction does (out of the range of
+/// `i64`: `i64::MIN`), so that both kernels agree on every input. The fraction is 1 only when `x`
+/// is a hair below an integer, where the noise is continuous across the cell face, so the value
+/// is still right.
 #[inline(always)]
 fn split(x: f64) -> (i64, f64) {
+    if x.abs() >= SPLIT_LIMIT {
+        return split_far(x);
+    }
     let t = x + ROUND_MAGIC;
     let rounded = t - ROUND_MAGIC;
     let below = rounded > x;
     let i = (t.to_bits() as i64).wrapping_sub(ROUND_MAGIC.to_bits() as i64) - i64::from(below);
     let f = (x - rounded) + f64::from(u8::from(below));
     (i, f)
+}
+
+/// `2^51`: the coordinates `split` rounds with [`ROUND_MAGIC`].
+const SPLIT_LIMIT: f64 = 2_251_799_813_685_248.0;
+
+/// [`split`] beyond `2^51` lattice cells: `floor(x)`, converted to `i64` as x86's `cvtpd2qq`
+/// does (`i64::MIN` where it does not fit), and `x - floor(x)`.
+#[cold]
+fn split_far(x: f64) -> (i64, f64) {
+    let floor = x.floor();
+    let cell = if floor.abs() < 9_223_372_036_854_775_808.0 {
+        floor as i64
+    } else {
+        i64::MIN
+    };
+    (cell, x - floor)
 }
 
 /// The quintic fade `6t^5 - 15t^4 + 10t^3` (zero first and second derivative at 0 and 1).
@@ -208,6 +230,12 @@ mod tests {
             1e15 + 0.5,
             -1e15 - 0.5,
             2251799813685247.5,
+            // From 2^51 on, `floor` (as the vector kernel's instruction).
+            2251799813685248.5,
+            -2251799813685248.5,
+            4503599627370497.0,
+            -1e17,
+            9.2e18,
         ];
         for x in xs.into_iter().chain(more) {
             let (i, f) = split(x);
@@ -220,6 +248,11 @@ mod tests {
             let (i, f) = split(x);
             assert_eq!(i as f64, x.floor(), "{x}");
             assert_eq!(f, x - x.floor(), "{x}");
+        }
+        // Out of the range of i64 the cell is i64::MIN, as x86's conversion gives, and the
+        // fraction 0.
+        for x in [9.3e18, -9.3e18, 1e300, -1e300, f64::MAX] {
+            assert_eq!(split(x), (i64::MIN, 0.0), "{x}");
         }
         // A hair below an integer the fraction may round to 1; the value is continuous there.
         let x = -1e-20;

@@ -9,7 +9,10 @@
 //! On x86-64 processors with AVX-512 (F and DQ: 64-bit lane multiplies and two-table permutes)
 //! the eight evaluations run in the lanes of 512-bit registers; elsewhere they are eight scalar
 //! calls. The vector kernel performs, lane by lane, exactly the scalar kernel's IEEE operations in
-//! the same order: the `1.5 * 2^52` split, the wrapping 64-bit lattice hash, the gradient
+//! the same order: the split into cell and fraction (here one `floor` instruction and a
+//! conversion, there the `1.5 * 2^52` rounding, which gives the same cell and fraction, and
+//! beyond `2^51` lattice cells `floor` and the conversion's result), the wrapping 64-bit lattice
+//! hash, the gradient
 //! coefficients (`-1`, `0` or `1`) multiplied and summed as `(gx x + gy y) + gz z`, the quintic
 //! fades, the trilinear blend, the final scale; no fused multiply-add, no reassociation. So the
 //! results are the same bits on both paths (tested on random and adversarial points), and a
@@ -147,7 +150,7 @@ pub(crate) fn scalar(q: &Lanes8) -> [f64; LANES] {
 #[allow(unsafe_code)]
 pub(crate) mod x86 {
     use super::{Lanes8, LANES};
-    use crate::noise::gradient::{GX, GY, GZ, ROUND_MAGIC, SCALE};
+    use crate::noise::gradient::{GX, GY, GZ, SCALE};
     use crate::noise::hash::{FINAL_MUL, LATTICE_X, LATTICE_Y, LATTICE_Z};
     use pmc_geometry::glam::DVec3;
     use std::arch::x86_64::*;
@@ -221,18 +224,15 @@ pub(crate) mod x86 {
         n
     }
 
-    /// `(cell, fraction)` of each lane, as the scalar `split`: the `1.5 * 2^52` rounding, one
-    /// subtracted from cells (one added to fractions) where the rounding went up.
+    /// `(cell, fraction)` of each lane, the scalar `split`'s bits: `floor(x)` by one rounding
+    /// instruction, converted to an integer (exactly below `2^63`), and the fraction
+    /// `x - floor(x)`. Below `2^51` the scalar `(x - round(x)) + 1` (where the rounding went up)
+    /// rounds the same exact real once, since `x - round(x)` is exact; both give `+0` at
+    /// integers, `-0` included. Beyond, the scalar kernel takes `floor` too.
     #[inline(always)]
     unsafe fn split(x: __m512d) -> (__m512i, __m512d) {
-        let magic = _mm512_set1_pd(ROUND_MAGIC);
-        let t = _mm512_add_pd(x, magic);
-        let rounded = _mm512_sub_pd(t, magic);
-        let below = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(rounded, x);
-        let cell = _mm512_sub_epi64(_mm512_castpd_si512(t), _mm512_set1_epi64(ROUND_MAGIC.to_bits() as i64));
-        let cell = _mm512_mask_sub_epi64(cell, below, cell, _mm512_set1_epi64(1));
-        let one = _mm512_maskz_mov_pd(below, _mm512_set1_pd(1.0));
-        (cell, _mm512_add_pd(_mm512_sub_pd(x, rounded), one))
+        let floor = _mm512_roundscale_pd::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(x);
+        (_mm512_cvtpd_epi64(floor), _mm512_sub_pd(x, floor))
     }
 
     /// The quintic fade `t t t (t (t 6 - 15) + 10)`, in the scalar order.
@@ -711,12 +711,14 @@ mod tests {
     use crate::noise::hash::{mix64, unit_f64};
 
     /// Points that stress the split and the hash: random ones at several scales (up to Earth
-    /// radius and beyond), exact integers, halves, values a hair off integers, negative zero.
+    /// radius and far beyond), exact integers, halves, values a hair off integers, negative zero.
     fn hard_points(n: usize) -> Vec<(DVec3, u64)> {
         let mut out = Vec::new();
         for i in 0..n as u64 {
             let r = |k: u64| unit_f64(mix64(i * 7 + k)) * 2.0 - 1.0;
-            let scale = [1.0, 37.0, 1e3, 6.4e6, 3e9][(i % 5) as usize];
+            // Up to 2e15 (about 2^51 lattice cells, where the scalar kernel's rounding stops)
+            // and far beyond, out of the range of `i64`.
+            let scale = [1.0, 37.0, 1e3, 6.4e6, 3e9, 2e15, 1e17, 1e300][(i % 8) as usize];
             let mut p = DVec3::new(r(0), r(1), r(2)) * scale;
             match i % 7 {
                 1 => p = p.round(),
