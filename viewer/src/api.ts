@@ -168,12 +168,23 @@ export interface PathAnswer {
   steps: number | null;
   /** The surface points walked, start and goal included (empty when not found). */
   waypoints: PathWaypoint[];
+  /** The walk pulled into straight legs (when found on a whole-planet grid). */
+  smoothed: SmoothedPath | null;
   /** Why there is no path (when not found). */
   reason: string | null;
   /** The components of the two ends when they differ (when not found). */
   components: [number, number] | null;
   /** The world revision the grid reflects. */
   revision: number;
+}
+
+/** A path's smoothed form (`smoothed` of docs/specs/path-v1.md). */
+export interface SmoothedPath {
+  /** Metres walked along the legs. */
+  length: number;
+  legs: number;
+  /** The ground the legs walk, a point for every column they cross (`line`, 1.3; the corners from older servers). */
+  line: PathWaypoint[];
 }
 
 /** The answer of `GET /navgrid`: nodes near a point, their components and the steps between them. */
@@ -439,24 +450,35 @@ function checkPathAnswer(body: unknown, url: string): PathAnswer {
       length: null,
       steps: null,
       waypoints: [],
+      smoothed: null,
       reason: typeof a['reason'] === 'string' ? a['reason'] : 'no reason given',
       components: Array.isArray(c) && c.length === 2 && c.every(finite) ? [c[0], c[1]] : null,
       revision,
     };
   }
-  const w = a['waypoints'];
-  if (!Array.isArray(w) || w.length === 0) throw bad('a path found without waypoints');
-  const waypoints: PathWaypoint[] = w.map((p: unknown, i) => {
-    const q = p as Record<string, unknown> | null;
-    if (!q || !finite(q['lat']) || !finite(q['lon']) || !finite(q['alt'])) throw bad(`waypoint ${i} is not {lat, lon, alt}`);
-    return { lat: q['lat'], lon: q['lon'], alt: q['alt'] };
-  });
+  const points = (w: unknown, what: string): PathWaypoint[] => {
+    if (!Array.isArray(w) || w.length === 0) throw bad(`a path found without ${what}`);
+    return w.map((p: unknown, i) => {
+      const q = p as Record<string, unknown> | null;
+      if (!q || !finite(q['lat']) || !finite(q['lon']) || !finite(q['alt'])) throw bad(`${what}: point ${i} is not {lat, lon, alt}`);
+      return { lat: q['lat'], lon: q['lon'], alt: q['alt'] };
+    });
+  };
+  const waypoints = points(a['waypoints'], 'waypoints');
   if (!finite(a['length'])) throw bad('a path found without a length');
+  let smoothed: SmoothedPath | null = null;
+  const sm = a['smoothed'] as Record<string, unknown> | null | undefined;
+  if (sm !== undefined && sm !== null) {
+    if (typeof sm !== 'object' || !finite(sm['length']) || !finite(sm['legs'])) throw bad('"smoothed" without a length and legs');
+    const line = sm['line'] !== undefined ? points(sm['line'], 'smoothed.line') : points(sm['waypoints'], 'smoothed.waypoints');
+    smoothed = { length: sm['length'], legs: sm['legs'], line };
+  }
   return {
     found: true,
     length: a['length'],
     steps: finite(a['steps']) ? a['steps'] : waypoints.length - 1,
     waypoints,
+    smoothed,
     reason: null,
     components: null,
     revision,

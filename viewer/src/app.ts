@@ -455,7 +455,7 @@ export class App implements TestHookTarget {
     if (this.pathDrawn !== this.pathTool.version) {
       this.pathDrawn = this.pathTool.version;
       const ps = this.pathTool.status();
-      this.navScene.setPath(ps.waypoints.length >= 2 ? ps.waypoints : null);
+      this.navScene.setPath(ps.line.length >= 2 ? ps.line : null);
       this.navScene.setMarkers(ps.from?.point ?? null, ps.to?.point ?? null);
     }
     if (this.gridDrawn !== this.navLoader.version) {
@@ -598,7 +598,9 @@ function pathStatsText(s: PathStatus): string {
     case 'loading':
       return 'finding…';
     case 'found':
-      return `${formatDistance(s.length!)} · ${s.steps} step${s.steps === 1 ? '' : 's'}`;
+      return s.smoothed
+        ? `${formatDistance(s.smoothed.length)} · ${s.smoothed.legs} leg${s.smoothed.legs === 1 ? '' : 's'}`
+        : `${formatDistance(s.length!)} · ${s.steps} step${s.steps === 1 ? '' : 's'}`;
     case 'none':
       return 'no path';
     case 'error':

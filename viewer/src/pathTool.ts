@@ -38,15 +38,19 @@ export interface PathStatus {
   phase: PathPhase;
   from: PathPick | null;
   to: PathPick | null;
-  /** Metres and steps of the path found. */
+  /** Metres and steps of the path found (its walk of grid steps). */
   length: number | null;
   steps: number | null;
+  /** Metres walked and straight legs of its smoothed form, when the answer has one. */
+  smoothed: { length: number; legs: number } | null;
   /** Why there is no path (phase none). */
   reason: string | null;
   /** The failed request (phase error). */
   error: string | null;
   /** The waypoints of the path found, planet frame (their surface points). */
   waypoints: V3[];
+  /** The points to draw, planet frame: the smoothed path's line, else the waypoints. */
+  line: V3[];
   /** The world revision of the answer shown. */
   revision: number | null;
   /** Asking again (after an edit) while the previous answer is still shown. */
@@ -76,8 +80,13 @@ export function pathMessage(s: Omit<PathStatus, 'message'>): string {
       return `${note}path start set (${s.from!.lat.toFixed(4)}°, ${s.from!.lon.toFixed(4)}°): click the goal`;
     case 'loading':
       return `${note}finding the path…`;
-    case 'found':
-      return `${note}path: ${formatDistance(s.length!)}, ${s.steps} step${s.steps === 1 ? '' : 's'}${s.refreshing ? ' (updating)' : ''}`;
+    case 'found': {
+      const steps = `${s.steps} step${s.steps === 1 ? '' : 's'}`;
+      const shown = s.smoothed
+        ? `${formatDistance(s.smoothed.length)} in ${s.smoothed.legs} straight leg${s.smoothed.legs === 1 ? '' : 's'} (grid walk ${formatDistance(s.length!)}, ${steps})`
+        : `${formatDistance(s.length!)}, ${steps}`;
+      return `${note}path: ${shown}${s.refreshing ? ' (updating)' : ''}`;
+    }
     case 'none':
       return `${note}no path: ${s.reason ?? 'no reason given'}${s.refreshing ? ' (updating)' : ''}`;
     case 'error':
@@ -94,6 +103,7 @@ export class PathTool {
   private to: PathPick | null = null;
   private answer: PathAnswer | null = null;
   private waypoints: V3[] = [];
+  private line: V3[] = [];
   private error: string | null = null;
   private notice: string | null = null;
   private inFlight: AbortController | null = null;
@@ -132,7 +142,7 @@ export class PathTool {
     this.from = pick;
     this.to = null;
     this.answer = null;
-    this.waypoints = [];
+    this.setPoints(null);
     this.error = null;
     this.phase = 'start';
     this.version++;
@@ -147,7 +157,7 @@ export class PathTool {
     this.from = null;
     this.to = null;
     this.answer = null;
-    this.waypoints = [];
+    this.setPoints(null);
     this.error = null;
     this.notice = null;
     this.version++;
@@ -174,6 +184,13 @@ export class PathTool {
     return { point: [point[0], point[1], point[2]], ...end, query: formatPathEnd(end) };
   }
 
+  /** The points of `answer` (planet frame), none when null or not found. */
+  private setPoints(answer: PathAnswer | null): void {
+    const frame = (ws: PathAnswer['waypoints']): V3[] => ws.map((w) => pointOfEnd(w, this.datum));
+    this.waypoints = answer?.found ? frame(answer.waypoints) : [];
+    this.line = answer?.found && answer.smoothed ? frame(answer.smoothed.line) : this.waypoints;
+  }
+
   private abort(): void {
     this.inFlight?.abort();
     this.inFlight = null;
@@ -189,7 +206,7 @@ export class PathTool {
     if (!keepShown || (this.phase !== 'found' && this.phase !== 'none')) {
       this.phase = 'loading';
       this.answer = null;
-      this.waypoints = [];
+      this.setPoints(null);
       this.error = null;
       this.version++;
     }
@@ -200,11 +217,11 @@ export class PathTool {
       this.answer = answer;
       this.error = null;
       this.phase = answer.found ? 'found' : 'none';
-      this.waypoints = answer.found ? answer.waypoints.map((w) => pointOfEnd(w, this.datum)) : [];
+      this.setPoints(answer);
     } catch (e) {
       if (this.inFlight !== ctl || isAbort(e)) return;
       this.answer = null;
-      this.waypoints = [];
+      this.setPoints(null);
       this.phase = 'error';
       this.error = navErrorMessage('the path request', e);
     }
@@ -221,9 +238,11 @@ export class PathTool {
       to: this.to,
       length: a?.found ? a.length : null,
       steps: a?.found ? a.steps : null,
+      smoothed: a?.found && a.smoothed ? { length: a.smoothed.length, legs: a.smoothed.legs } : null,
       reason: a && !a.found ? a.reason : null,
       error: this.error,
       waypoints: this.waypoints,
+      line: this.line,
       revision: a?.revision ?? null,
       refreshing: this.inFlight !== null && (this.phase === 'found' || this.phase === 'none'),
       notice: this.notice,

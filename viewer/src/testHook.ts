@@ -75,14 +75,16 @@ export interface PmcStats {
 }
 
 /** `__pmc.path()`: the Path tool's state, and where the path drawn lies on the canvas. */
-export interface PmcPathHook extends Omit<PathStatus, 'waypoints' | 'from' | 'to'> {
+export interface PmcPathHook extends Omit<PathStatus, 'waypoints' | 'line' | 'from' | 'to'> {
   /** The ends as sent to `/path` (`LAT,LON,ALT`), null when not set. */
   from: string | null;
   to: string | null;
   fromPoint: V3 | null;
   toPoint: V3 | null;
-  /** Waypoints of the path shown. */
+  /** Waypoints of the path found (its walk of grid steps). */
   waypoints: number;
+  /** Points of the line drawn (the smoothed path's, else the waypoints). */
+  line: number;
   /** The drawn (lifted) waypoints on the canvas, CSS pixels; null where behind the camera. */
   screen: ([number, number] | null)[];
   /** The tool is chosen. */
@@ -191,7 +193,7 @@ export type ToScreen = (p: V3) => [number, number] | null;
 
 /** `__pmc.path()` of the Path tool's state, its drawn waypoints and whether the tool is chosen. */
 export function pathHookOf(s: PathStatus, drawn: V3[], toScreen: ToScreen, active: boolean): PmcPathHook {
-  const { waypoints: _w, from, to, ...rest } = s;
+  const { waypoints: _w, line: _l, from, to, ...rest } = s;
   return {
     ...rest,
     from: from?.query ?? null,
@@ -199,6 +201,7 @@ export function pathHookOf(s: PathStatus, drawn: V3[], toScreen: ToScreen, activ
     fromPoint: from?.point ?? null,
     toPoint: to?.point ?? null,
     waypoints: s.waypoints.length,
+    line: s.line.length,
     screen: drawn.map((p) => toScreen(p)),
     active,
   };

@@ -21,6 +21,15 @@ const FOUND = {
     { lat: -10.6, lon: 8.1, alt: 48.25 },
   ],
 };
+/** FOUND with its smoothed form (spec 1.3): one straight leg, drawn through a point between. */
+const SMOOTHED = {
+  ...FOUND,
+  smoothed: {
+    length: 21.25, legs: 1,
+    waypoints: [FOUND.waypoints[0], FOUND.waypoints[2]],
+    line: [FOUND.waypoints[0], { lat: -10.3, lon: 8.05, alt: 50.4 }, FOUND.waypoints[2]],
+  },
+};
 const NONE = {
   format: 'pmc-path', version: 1, found: false, revision: 0,
   reason: 'the two ends lie in different components of the grid (detached grids)', components: [0, 457], waypoints: [],
@@ -100,7 +109,42 @@ describe('PathTool', () => {
     const w0 = pathEndOf(s.waypoints[0]!, DATUM);
     expect([w0.lat, w0.lon]).toEqual([expect.closeTo(-10, 9), expect.closeTo(8, 9)]);
     expect(w0.alt).toBeCloseTo(52.5, 9);
+    // without a smoothed form, the walk is what is drawn
+    expect([s.smoothed, s.line]).toEqual([null, s.waypoints]);
     expect(changes()).toBeGreaterThanOrEqual(3);
+  });
+
+  it('a path with a smoothed form shows its length and legs and draws its line', async () => {
+    const { tool, f } = setup();
+    tool.click(A);
+    tool.click(B);
+    f.calls[0]!.resolve(json(SMOOTHED));
+    await flush();
+    const s = tool.status();
+    expect([s.phase, s.length, s.steps, s.smoothed]).toEqual(['found', 23.5, 2, { length: 21.25, legs: 1 }]);
+    expect(s.message).toBe('path: 21.3 m in 1 straight leg (grid walk 23.5 m, 2 steps)');
+    expect([s.waypoints.length, s.line.length]).toEqual([3, 3]);
+    const mid = pathEndOf(s.line[1]!, DATUM);
+    expect([mid.lat, mid.lon, mid.alt]).toEqual([expect.closeTo(-10.3, 9), expect.closeTo(8.05, 9), expect.closeTo(50.4, 9)]);
+    // a 1.2 answer (no line) draws the corners
+    tool.refresh();
+    const { line: _l, ...older } = SMOOTHED.smoothed;
+    f.calls[1]!.resolve(json({ ...SMOOTHED, smoothed: older }));
+    await flush();
+    expect(tool.status().line.length).toBe(2);
+  });
+
+  it('a smoothed form without a length or with a bad point is a malformed answer', async () => {
+    for (const smoothed of [{ ...SMOOTHED.smoothed, length: null }, { ...SMOOTHED.smoothed, line: [{ lat: 1, lon: 2 }] }]) {
+      const { tool, f } = setup();
+      tool.click(A);
+      tool.click(B);
+      f.calls[0]!.resolve(json({ ...SMOOTHED, smoothed }));
+      await flush();
+      const s = tool.status();
+      expect([s.phase, s.waypoints.length, s.line.length]).toEqual(['error', 0, 0]);
+      expect(s.error).toMatch(/unexpected answer from api\/v1\/path/);
+    }
   });
 
   it('a click in a cave sends the cave floor\'s altitude (below the datum)', () => {
@@ -236,8 +280,11 @@ describe('PathTool', () => {
   });
 
   it('messages for every phase', () => {
-    const base = { from: null, to: null, length: null, steps: null, reason: null, error: null, waypoints: [], revision: null, refreshing: false, notice: null, requests: 0 };
+    const base = { from: null, to: null, length: null, steps: null, smoothed: null, reason: null, error: null, waypoints: [], line: [], revision: null, refreshing: false, notice: null, requests: 0 };
     expect(pathMessage({ ...base, phase: 'found', length: 1234.5, steps: 100 })).toBe('path: 1.23 km, 100 steps');
+    expect(pathMessage({ ...base, phase: 'found', length: 1234.5, steps: 100, smoothed: { length: 1100, legs: 3 } })).toBe(
+      'path: 1.10 km in 3 straight legs (grid walk 1.23 km, 100 steps)',
+    );
     expect(pathMessage({ ...base, phase: 'none', reason: null })).toBe('no path: no reason given');
     expect(pathMessage({ ...base, phase: 'error', error: null })).toBe('the path request failed');
   });

@@ -87,8 +87,9 @@ impl<N> PathAnswer<N> {
 /// What a document says about the grid, beside the answer.
 struct Facts {
     agent: Agent,
-    /// The smoothed path of a path found on the whole-planet grid.
-    smoothed: Option<SmoothPath>,
+    /// The smoothed path of a path found on the whole-planet grid, and the ground its legs walk
+    /// ([`SmoothPath::ground`]).
+    smoothed: Option<(SmoothPath, Vec<DVec3>)>,
     /// The `grid` member.
     grid: Value,
     /// The component of a path found.
@@ -103,7 +104,11 @@ impl Facts {
         Facts {
             agent: *grid.agent(),
             smoothed: match answer {
-                PathAnswer::Found(p) => Some(smooth_path(grid, p)),
+                PathAnswer::Found(p) => {
+                    let s = smooth_path(grid, p);
+                    let ground = s.ground(grid);
+                    Some((s, ground))
+                }
                 _ => None,
             },
             grid: json!({ "nodes": grid.node_count(), "components": grid.component_sizes().len() }),
@@ -159,10 +164,12 @@ fn json_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End, da
             v["component"] = facts.component;
             v["waypoints"] = json!(w);
             v["expanded"] = json!(p.expanded);
-            if let Some(s) = &facts.smoothed {
+            if let Some((s, ground)) = &facts.smoothed {
                 let corners: Vec<Value> = s.points.iter().map(|q| waypoint(*q, datum)).collect();
-                v["smoothed"] =
-                    json!({ "length": s.length, "legs": s.corners.len().saturating_sub(1), "waypoints": corners });
+                let line: Vec<Value> = ground.iter().map(|q| waypoint(*q, datum)).collect();
+                v["smoothed"] = json!({
+                    "length": s.length, "legs": s.corners.len().saturating_sub(1), "waypoints": corners, "line": line,
+                });
             }
         }
         other => {
@@ -201,7 +208,7 @@ fn geojson_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End,
     }
     features.push(point(from, "from"));
     features.push(point(to, "to"));
-    if let Some(s) = &facts.smoothed {
+    if let Some((s, _)) = &facts.smoothed {
         let line: Vec<Value> = s.points.iter().map(|q| coords(*q)).collect();
         features.push(json!({
             "type": "Feature",
@@ -220,7 +227,8 @@ fn geojson_document<N>(facts: Facts, answer: &PathAnswer<N>, from: End, to: End,
 }
 
 /// The JSON document of a path query from `from` to `to` (the points asked for, planet frame);
-/// a path found comes with its smoothed form ([`smooth_path`]) in a `smoothed` member (spec 1.2).
+/// a path found comes with its smoothed form ([`smooth_path`]) in a `smoothed` member (spec 1.2),
+/// with the ground its legs walk as a `line` (spec 1.3).
 pub fn path_json(grid: &NavGrid, answer: &PathAnswer, from: End, to: End, datum: f64) -> Value {
     json_document(Facts::eager(grid, answer), answer, from, to, datum)
 }

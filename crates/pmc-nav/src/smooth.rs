@@ -50,7 +50,7 @@ pub struct SmoothPath {
 
 impl SmoothPath {
     /// Points along the legs, at most `spacing` metres apart along each (at least one point a
-    /// leg), corners included: on each leg's great circle at its interpolated radius, for
+    /// leg), the corners included exactly: on each leg's great circle at its interpolated radius, for
     /// drawing the legs over a curved planet. A `spacing` that is not a number above 0 gives the
     /// corners alone.
     pub fn densify(&self, spacing: f64) -> Vec<DVec3> {
@@ -63,7 +63,28 @@ impl SmoothPath {
                 1
             };
             let leg = Leg::new(a, b);
-            out.extend((1..=n).map(|i| leg.at(i as f64 / n as f64)));
+            out.extend((1..n).map(|i| leg.at(i as f64 / n as f64)));
+            out.push(b);
+        }
+        out
+    }
+
+    /// The ground the legs walk, for drawing the path on the terrain: the start, then for each
+    /// column a leg crosses, the point where the leg enters it lifted or lowered to the surface
+    /// of the node it walks on there (the walkable floor, within the agent's step height of the
+    /// leg), each corner exactly. A leg kept as the grid step it is (one that fails the check,
+    /// see the module docs) gives its end alone. `grid` must be the grid the path was smoothed
+    /// on.
+    pub fn ground(&self, grid: &NavGrid) -> Vec<DVec3> {
+        let mut out: Vec<DVec3> = self.points.first().copied().into_iter().collect();
+        for (w, p) in self.corners.windows(2).zip(self.points.windows(2)) {
+            let mut entries = Vec::new();
+            if walk_leg(grid, w[0], w[1], |dir, node| entries.push(dir * node.radius)).is_some() {
+                // The last entry is the goal's column: its corner, exactly.
+                entries.pop();
+                out.extend(entries);
+            }
+            out.push(p[1]);
         }
         out
     }
@@ -204,6 +225,13 @@ const MAX_LEG_ANGLE: f64 = 3.0;
 /// The length of the straight leg from node `a` to node `b` when the agent can walk it (module
 /// docs), else `None`.
 fn straight_leg(grid: &NavGrid, a: NodeId, b: NodeId) -> Option<f64> {
+    walk_leg(grid, a, b, |_, _| {})
+}
+
+/// [`straight_leg`], calling `on_column(dir, node)` for each column the leg enters after `a`'s,
+/// in order, with the leg's direction where it enters and the node it walks onto there (the
+/// last call is `b`'s column, when the leg holds).
+fn walk_leg(grid: &NavGrid, a: NodeId, b: NodeId, mut on_column: impl FnMut(DVec3, &Node)) -> Option<f64> {
     let columns = grid.columns();
     let (ca, na) = grid.node(a)?;
     let (cb, nb) = grid.node(b)?;
@@ -231,6 +259,7 @@ fn straight_leg(grid: &NavGrid, a: NodeId, b: NodeId) -> Option<f64> {
         if c != col {
             at = cross(grid, col, at, c, r, tol, b)?;
             col = c;
+            on_column(dir, &at.1);
         }
         if (at.1.radius - r).abs() > tol {
             return None;

@@ -110,7 +110,7 @@ fn corners_follow_the_path(path: &[NodeId], corners: &[NodeId]) -> bool {
 fn on_the_default_planet_smoothed_legs_never_cross_a_filled_voxel_or_a_column_without_ground() {
     let g = default_grid();
     let mut rng = common::Lcg(11);
-    let mut checked = 0;
+    let (mut checked, mut drawn) = (0, 0);
     while checked < 40 {
         let a = rng.dir();
         let b = (a + rng.dir() * 0.15).normalize();
@@ -122,8 +122,38 @@ fn on_the_default_planet_smoothed_legs_never_cross_a_filled_voxel_or_a_column_wi
         assert!(corners_follow_the_path(&path.nodes, &s.corners));
         assert!(s.length <= path.length * 1.0001, "{} vs {}", s.length, path.length);
         assert_walkable(g, &s, 8.0);
+        drawn += assert_ground_is_walked(g, &s);
         checked += 1;
     }
+    assert!(drawn > 200, "only {drawn} ground points between corners in 40 paths");
+}
+
+/// The ground drawn under a smoothed path ([`SmoothPath::ground`]) starts and ends at the path's
+/// ends and passes its corners in order; every other point lies on the surface of a node of the
+/// column under it, within the agent's step height of its leg. Returns how many such points.
+fn assert_ground_is_walked(g: &NavGrid, s: &SmoothPath) -> usize {
+    let ground = s.ground(g);
+    assert_eq!((ground.first(), ground.last()), (s.points.first(), s.points.last()));
+    let mut at = 0;
+    for c in &s.points {
+        at += ground[at..].iter().position(|p| p == c).expect("a corner missing from the ground line");
+    }
+    let step = g.agent().step_up.max(g.agent().step_down);
+    let legs: Vec<(DVec3, DVec3)> = s.points.windows(2).map(|w| (w[0], w[1])).collect();
+    for p in ground.iter().filter(|p| !s.points.contains(p)) {
+        let col = g.columns().nearest(*p).unwrap();
+        let on_node = g.column_nodes(col).any(|(_, n)| (n.radius - p.length()).abs() < 1e-9);
+        assert!(on_node, "a ground point {p} on no node's surface");
+        let off = legs
+            .iter()
+            .map(|(a, b)| {
+                let t = (a.angle_between(*p) / a.angle_between(*b)).clamp(0.0, 1.0);
+                (leg_point(*a, *b, t).length() - p.length()).abs()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(off <= step + 1e-6, "a ground point {off} m off its leg");
+    }
+    ground.len() - s.points.len()
 }
 
 #[test]

@@ -53,6 +53,13 @@ async fn path_answers_the_walk_and_its_smoothed_form_as_json_or_geojson() {
         "{v}"
     );
     assert_eq!(smoothed["waypoints"][0], v["waypoints"][0]);
+    // Its line (for drawing) starts and ends at the walk's ends and passes every corner.
+    let line = smoothed["line"].as_array().unwrap();
+    let corners = smoothed["waypoints"].as_array().unwrap();
+    assert!(line.len() >= corners.len(), "{smoothed}");
+    assert_eq!(line.first(), corners.first());
+    assert_eq!(line.last(), corners.last());
+    assert!(corners.iter().all(|c| line.contains(c)), "{smoothed}");
     let g = get(&a, "/api/v1/path?from=10,10&to=12,40&format=geojson").await.json();
     let last = g["features"].as_array().unwrap().last().unwrap().clone();
     assert_eq!(last["properties"]["role"], "smoothed");

@@ -109,17 +109,25 @@ export async function scenario(t) {
   log(`  ${p.from} -> ${p.to}: ${p.message}`);
   check(p.phase === 'found', `no path between two points of the close-up: ${p.phase}: ${p.message}`);
   check(p.length > 0 && p.steps >= 1 && p.waypoints === p.steps + 1, `path length ${p.length} m, ${p.steps} steps, ${p.waypoints} waypoints`);
-  const metres = p.length >= 1000 ? `${(p.length / 1000).toFixed(2)} km` : `${p.length.toFixed(1)} m`; // as src/ui.ts formatDistance
+  const distance = (m) => (m >= 1000 ? `${(m / 1000).toFixed(2)} km` : `${m.toFixed(1)} m`); // as src/ui.ts formatDistance
   const stepsText = `${p.steps} step${p.steps === 1 ? '' : 's'}`;
+  // the smoothed path is what the panels tell and what is drawn
+  check(p.smoothed !== null && p.smoothed.legs >= 1 && p.smoothed.length <= p.length * 1.0001,
+    `the path found has no smoothed form, or a longer one: ${JSON.stringify(p.smoothed)}, walk ${p.length} m`);
+  const legsText = `${p.smoothed.legs} leg${p.smoothed.legs === 1 ? '' : 's'}`;
   const shownText = await page.textContent('#path-status');
-  check(shownText.startsWith(`path: ${metres}, ${stepsText}`), `the tools panel shows "${shownText}"`);
+  check(shownText.startsWith(`path: ${distance(p.smoothed.length)} in ${p.smoothed.legs} straight leg${p.smoothed.legs === 1 ? '' : 's'} (grid walk ${distance(p.length)}, ${stepsText})`),
+    `the tools panel shows "${shownText}"`);
   const statsText = await page.textContent('#s-path');
-  check(statsText === `${metres} · ${stepsText}`, `the stats panel shows "${statsText}" for the path`);
-  // the server, asked the same, walks the same length
+  check(statsText === `${distance(p.smoothed.length)} · ${legsText}`, `the stats panel shows "${statsText}" for the path`);
+  // the server, asked the same, walks the same length, and its smoothed line is the one drawn
   const q = `path?preset=earthlike&seed=7&from=${encodeURIComponent(p.from)}&to=${encodeURIComponent(p.to)}`;
   const direct = await apiGet(q);
   check(direct.found === true && Math.abs(direct.length - p.length) < 1e-9 && direct.steps === p.steps,
     `GET /api/v1/${q}: found ${direct.found}, ${direct.length} m, ${direct.steps} steps; the page shows ${p.length} m, ${p.steps} steps`);
+  check(direct.smoothed.length === p.smoothed.length && direct.smoothed.line.length === p.line && p.screen.length === p.line,
+    `the smoothed path: ${direct.smoothed.length} m in ${direct.smoothed.line.length} line points from the server; the page shows ${p.smoothed.length} m and draws ${p.screen.length} of ${p.line} points`);
+  log(`  smoothed: ${p.smoothed.length.toFixed(1)} m in ${p.smoothed.legs} legs, drawn through ${p.line} points (the walk: ${p.waypoints} waypoints)`);
   // pixels along the drawn path changed (where the terrain hides it, its faint copy shows)
   const after = await shot('path');
   const samples = [];
