@@ -420,8 +420,9 @@ pub(crate) mod x86 {
                     add!(i + LANES, s);
                 }
                 None => {
-                    add!(i, eval_cells_cached(groups[0], seed, &mut corners));
-                    add!(i + LANES, eval_cells_cached(groups[1], seed, &mut corners));
+                    let (r, s) = eval_pair_cached(groups, seed, &mut corners);
+                    add!(i, r);
+                    add!(i + LANES, s);
                 }
             }
             i += 2 * LANES;
@@ -589,6 +590,54 @@ pub(crate) mod x86 {
     unsafe fn eval_cells(cells: [(__m512i, __m512d); 3], seed: __m512i) -> __m512d {
         let [(ix, fx), (iy, fy), (iz, fz)] = cells;
         eval_gradients(&corner_gradients(ix, iy, iz, seed), fx, fy, fz)
+    }
+
+    /// [`eval_cells`] of two groups, reusing corner gradients where a group lies in the same
+    /// cells as the group before it (every lane): the second group the first's, the first those
+    /// kept in `cache`.
+    ///
+    /// Gradients are kept (24 register stores) only where the two groups of a pair share their
+    /// cells, so that points which rarely do (scattered ones, fine octaves) do not pay the
+    /// stores for nothing, while a run of groups in the same cells (nearby points in a coarse
+    /// octave) computes its gradients once. The values are the same whichever gradients are
+    /// reused: the same numbers.
+    #[inline(always)]
+    unsafe fn eval_pair_cached(
+        groups: [[(__m512i, __m512d); 3]; 2],
+        seed: __m512i,
+        cache: &mut CornerCache,
+    ) -> (__m512d, __m512d) {
+        let [[(ix, fx), (iy, fy), (iz, fz)], [(jx, gx), (jy, gy), (jz, gz)]] = groups;
+        // (A macro, not a closure: a closure would be compiled without the kernel's features.)
+        macro_rules! same {
+            ($a:expr, $b:expr, $c:expr, $cells:expr) => {
+                (_mm512_cmpeq_epi64_mask($a, $cells[0])
+                    & _mm512_cmpeq_epi64_mask($b, $cells[1])
+                    & _mm512_cmpeq_epi64_mask($c, $cells[2]))
+                    == 0xFF
+            };
+        }
+        let hit = cache.valid && same!(ix, iy, iz, cache.cells);
+        let pair = same!(jx, jy, jz, [ix, iy, iz]);
+        if hit {
+            let r = eval_gradients(&cache.grads, fx, fy, fz);
+            if pair {
+                return (r, eval_gradients(&cache.grads, gx, gy, gz));
+            }
+            cache.valid = false;
+            return (r, eval_cells(groups[1], seed));
+        }
+        if pair {
+            cache.grads = corner_gradients(ix, iy, iz, seed);
+            cache.cells = [ix, iy, iz];
+            cache.valid = true;
+            return (
+                eval_gradients(&cache.grads, fx, fy, fz),
+                eval_gradients(&cache.grads, gx, gy, gz),
+            );
+        }
+        cache.valid = false;
+        (eval_cells(groups[0], seed), eval_cells(groups[1], seed))
     }
 
     /// [`eval_cells`] reusing the corner gradients of the last group when every lane lies in
