@@ -143,6 +143,15 @@ fn noise(c: &mut Criterion) {
             black_box(out.iter().sum::<f64>())
         })
     });
+    g.bench_function("fbm6/fastnoise-lite/scattered/samples=1024", |b| {
+        b.iter(|| {
+            let mut s = 0.0f32;
+            for d in &scattered {
+                s += fnl.get_noise_3d(d.x, d.y, d.z);
+            }
+            black_box(s)
+        })
+    });
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         let scaled = |v: &[f64]| -> Vec<f32> { v.iter().map(|c| (c * FREQUENCY) as f32).collect() };
