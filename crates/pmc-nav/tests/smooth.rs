@@ -136,7 +136,10 @@ fn assert_ground_is_walked(g: &NavGrid, s: &SmoothPath) -> usize {
     assert_eq!((ground.first(), ground.last()), (s.points.first(), s.points.last()));
     let mut at = 0;
     for c in &s.points {
-        at += ground[at..].iter().position(|p| p == c).expect("a corner missing from the ground line");
+        at += ground[at..]
+            .iter()
+            .position(|p| p == c)
+            .expect("a corner missing from the ground line");
     }
     let step = g.agent().step_up.max(g.agent().step_down);
     let legs: Vec<(DVec3, DVec3)> = s.points.windows(2).map(|w| (w[0], w[1])).collect();
