@@ -51,11 +51,18 @@ pub(super) const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
 /// `i64`: `i64::MIN`), so that both kernels agree on every input. The fraction is 1 only when `x`
 /// is a hair below an integer, where the noise is continuous across the cell face, so the value
 /// is still right.
-#[inline(always)]
+#[cfg(test)]
 fn split(x: f64) -> (i64, f64) {
     if x.abs() >= SPLIT_LIMIT {
-        return split_far(x);
+        split_far(x)
+    } else {
+        split_near(x)
     }
+}
+
+/// [`split`] for `|x| < 2^51`, the rounding (see there).
+#[inline(always)]
+fn split_near(x: f64) -> (i64, f64) {
     let t = x + ROUND_MAGIC;
     let rounded = t - ROUND_MAGIC;
     let below = rounded > x;
@@ -68,7 +75,8 @@ fn split(x: f64) -> (i64, f64) {
 const SPLIT_LIMIT: f64 = 2_251_799_813_685_248.0;
 
 /// [`split`] beyond `2^51` lattice cells: `floor(x)`, converted to `i64` as x86's `cvtpd2qq`
-/// does (`i64::MIN` where it does not fit), and `x - floor(x)`.
+/// does (`i64::MIN` where it does not fit), and `x - floor(x)`. Below `2^51` it gives
+/// [`split_near`]'s cell and fraction.
 #[cold]
 fn split_far(x: f64) -> (i64, f64) {
     let floor = x.floor();
@@ -129,9 +137,14 @@ struct Cell {
 impl Cell {
     #[inline(always)]
     fn new(p: DVec3) -> Cell {
-        let (ix, fx) = split(p.x);
-        let (iy, fy) = split(p.y);
-        let (iz, fz) = split(p.z);
+        // One test for the three coordinates: below 2^51 both splits agree, so a point with any
+        // coordinate beyond takes `split_far` for all three.
+        let far = p.x.abs().max(p.y.abs()).max(p.z.abs()) >= SPLIT_LIMIT;
+        let [(ix, fx), (iy, fy), (iz, fz)] = if far {
+            [split_far(p.x), split_far(p.y), split_far(p.z)]
+        } else {
+            [split_near(p.x), split_near(p.y), split_near(p.z)]
+        };
         let x0 = (ix as u64).wrapping_mul(LATTICE_X);
         let y0 = (iy as u64).wrapping_mul(LATTICE_Y);
         let z0 = (iz as u64).wrapping_mul(LATTICE_Z);
@@ -248,6 +261,10 @@ mod tests {
             let (i, f) = split(x);
             assert_eq!(i as f64, x.floor(), "{x}");
             assert_eq!(f, x - x.floor(), "{x}");
+            // Below 2^51 both splits give the same bits (a point takes one split for all three
+            // coordinates).
+            let (j, g) = split_far(x);
+            assert_eq!((j, g.to_bits()), (i, f.to_bits()), "{x}");
         }
         // Out of the range of i64 the cell is i64::MIN, as x86's conversion gives, and the
         // fraction 0.
