@@ -12,9 +12,10 @@
 //! the same order: the split into cell and fraction (here one `floor` instruction and a
 //! conversion, there the `1.5 * 2^52` rounding, which gives the same cell and fraction, and
 //! beyond `2^51` lattice cells `floor` and the conversion's result), the wrapping 64-bit lattice
-//! hash, the gradient
-//! coefficients (`-1`, `0` or `1`) multiplied and summed as `(gx x + gy y) + gz z`, the quintic
-//! fades, the trilinear blend, the final scale; no fused multiply-add, no reassociation. So the
+//! hash, the gradient coefficients (`-1`, `0` or `1`) multiplied and summed as
+//! `(gx x + gy y) + gz z`, the quintic fades, the trilinear blend, the final scale; no
+//! reassociation, and fused multiply-adds only where the product is exact (a gradient
+//! coefficient times an offset), so that they round as the separate multiply and add do. So the
 //! results are the same bits on both paths (tested on random and adversarial points), and a
 //! planet is byte-identical whatever the processor.
 //!
@@ -272,58 +273,16 @@ pub(crate) mod x86 {
         }
     }
 
-    /// A gradient component `g` (`-1`, `0` or `1`) as a mask `m` for which
-    /// [`times_gradient`]`(d, m)` is exactly the bits of `g * d`: `1` is `0x7FFF_FFFF_FFFF_FFFF`,
-    /// `-1` all ones, `0` all zeros.
-    const fn gradient_masks(g: &[f64; 16]) -> [i64; 16] {
-        let mut out = [0i64; 16];
-        let mut i = 0;
-        while i < 16 {
-            out[i] = if g[i] > 0.0 {
-                i64::MAX
-            } else if g[i] < 0.0 {
-                -1
-            } else {
-                0
-            };
-            i += 1;
-        }
-        out
-    }
-    const MX: [i64; 16] = gradient_masks(&GX);
-    const MY: [i64; 16] = gradient_masks(&GY);
-    const MZ: [i64; 16] = gradient_masks(&GZ);
-
-    /// `g * d` from `g`'s mask `m` (see [`gradient_masks`]), exactly: below the sign bit
-    /// `d & m` (all of `d`, or zero), at the sign bit `d ^ m` (kept or flipped). The product of
-    /// `+0` and a finite `d` is a zero with `d`'s sign, as here. One bitwise operation
-    /// (`c ? a ^ b : a & b` with `c` the sign bit: truth table `0x68`) instead of a
-    /// floating-point multiply.
+    /// A corner's `(gx dx + gy dy) + gz dz` with the scalar kernel's bits: a multiply, then
+    /// two fused multiply-adds. Each product of a gradient component (`-1`, `0` or `1`) by an
+    /// offset is exact, so a fused `g d + t` rounds the same exact sum once, as the scalar
+    /// `g d` then `+ t` does, and IEEE 754 gives its zeros the sign rules of that addition:
+    /// the same number, the same bits, in three operations instead of five.
     #[inline(always)]
-    unsafe fn times_gradient(d: __m512d, m: __m512i) -> __m512d {
-        let sign = _mm512_set1_epi64(i64::MIN);
-        _mm512_castsi512_pd(_mm512_ternarylogic_epi64::<0x68>(_mm512_castpd_si512(d), m, sign))
-    }
-
-    /// The sixteen gradient masks of one axis, as two registers of eight.
-    struct MaskTable {
-        lo: __m512i,
-        hi: __m512i,
-    }
-
-    impl MaskTable {
-        #[inline(always)]
-        unsafe fn new(v: &[i64; 16]) -> MaskTable {
-            MaskTable {
-                lo: _mm512_loadu_si512(v.as_ptr().cast()),
-                hi: _mm512_loadu_si512(v.as_ptr().add(8).cast()),
-            }
-        }
-        /// Entry `idx` (0..16) of each lane.
-        #[inline(always)]
-        unsafe fn get(&self, idx: __m512i) -> __m512i {
-            _mm512_permutex2var_epi64(self.lo, idx, self.hi)
-        }
+    unsafe fn dot(g: [__m512d; 3], dx: __m512d, dy: __m512d, dz: __m512d) -> __m512d {
+        let t = _mm512_mul_pd(g[0], dx);
+        let t = _mm512_fmadd_pd(g[1], dy, t);
+        _mm512_fmadd_pd(g[2], dz, t)
     }
 
     #[target_feature(enable = "avx512f,avx512dq")]
@@ -579,19 +538,15 @@ pub(crate) mod x86 {
     /// `q` along them and `k` (seeded) across: [`corner_gradients`]' hash and table lookups.
     #[inline(always)]
     unsafe fn plane_gradient(p: __m512i, q: __m512i, k: __m512i, ta: &Table, tb: &Table) -> (__m512d, __m512d) {
-        let key = _mm512_xor_si512(_mm512_xor_si512(p, q), k);
-        let h = _mm512_mullo_epi64(
-            _mm512_xor_si512(key, _mm512_srli_epi64::<32>(key)),
-            _mm512_set1_epi64(FINAL_MUL as i64),
-        );
-        let idx = _mm512_srli_epi64::<60>(h);
+        let idx = corner_index(_mm512_xor_si512(p, q), k);
         (ta.get(idx), tb.get(idx))
     }
 
-    /// A corner's value on a plane: `ga da + gb db`.
+    /// A corner's value on a plane: `ga da + gb db`, the second product fused into the sum
+    /// (exact products: the same bits, as in [`dot`]).
     #[inline(always)]
     unsafe fn plane_dot(g: (__m512d, __m512d), da: __m512d, db: __m512d) -> __m512d {
-        _mm512_add_pd(_mm512_mul_pd(g.0, da), _mm512_mul_pd(g.1, db))
+        _mm512_fmadd_pd(g.1, db, _mm512_mul_pd(g.0, da))
     }
 
     /// The eight evaluations of the points `(x, y, z)` with seeds `seed`, lane by lane.
@@ -600,11 +555,40 @@ pub(crate) mod x86 {
         eval_cells([split(x), split(y), split(z)], seed)
     }
 
-    /// [`eval`] from the points' cells and fractions along x, y and z.
+    /// [`eval`] from the points' cells and fractions along x, y and z: [`eval_gradients`] of
+    /// [`corner_gradients`] (the same operations on the same numbers, so the same bits), with
+    /// each corner hashed, looked up and dotted in turn and each blend taken as soon as its two
+    /// values are there, so that a few corners' values are live at once instead of all 24
+    /// gradient components.
     #[inline(always)]
     unsafe fn eval_cells(cells: [(__m512i, __m512d); 3], seed: __m512i) -> __m512d {
         let [(ix, fx), (iy, fy), (iz, fz)] = cells;
-        eval_gradients(&corner_gradients(ix, iy, iz, seed), fx, fy, fz)
+        let keys = CornerKeys::new(ix, iy, iz, seed);
+        let (tx, ty, tz) = (Table::new(&GX), Table::new(&GY), Table::new(&GZ));
+        let one = _mm512_set1_pd(1.0);
+        let (gx, gy, gz) = (_mm512_sub_pd(fx, one), _mm512_sub_pd(fy, one), _mm512_sub_pd(fz, one));
+        let (u, v, w) = (fade(fx), fade(fy), fade(fz));
+        // (A macro, not a closure: a closure would be compiled without the kernel's features.)
+        macro_rules! corner {
+            ($xy:expr, $z:expr, $dx:expr, $dy:expr, $dz:expr) => {{
+                let idx = corner_index($xy, $z);
+                dot([tx.get(idx), ty.get(idx), tz.get(idx)], $dx, $dy, $dz)
+            }};
+        }
+        let k = &keys;
+        let n000 = corner!(k.k00, k.z0, fx, fy, fz);
+        let n100 = corner!(k.k10, k.z0, gx, fy, fz);
+        let l00 = lerp(u, n000, n100);
+        let n010 = corner!(k.k01, k.z0, fx, gy, fz);
+        let n110 = corner!(k.k11, k.z0, gx, gy, fz);
+        let a = lerp(v, l00, lerp(u, n010, n110));
+        let n001 = corner!(k.k00, k.z1, fx, fy, gz);
+        let n101 = corner!(k.k10, k.z1, gx, fy, gz);
+        let l01 = lerp(u, n001, n101);
+        let n011 = corner!(k.k01, k.z1, fx, gy, gz);
+        let n111 = corner!(k.k11, k.z1, gx, gy, gz);
+        let b = lerp(v, l01, lerp(u, n011, n111));
+        _mm512_mul_pd(lerp(w, a, b), _mm512_set1_pd(SCALE))
     }
 
     /// [`eval_cells`] of two groups, reusing corner gradients where a group lies in the same
@@ -681,87 +665,106 @@ pub(crate) mod x86 {
         valid: bool,
         /// The lanes' cells along x, y and z.
         cells: [__m512i; 3],
-        /// The gradient masks `(gx, gy, gz)` of the eight corners, in [`corner_gradients`]'
-        /// order.
-        grads: [[__m512i; 3]; 8],
+        /// The gradients `(gx, gy, gz)` of the eight corners, in [`corner_gradients`]' order.
+        grads: [[__m512d; 3]; 8],
     }
 
     impl CornerCache {
         #[inline(always)]
         unsafe fn new() -> CornerCache {
-            let zi = _mm512_setzero_si512();
             CornerCache {
                 valid: false,
-                cells: [zi; 3],
-                grads: [[zi; 3]; 8],
+                cells: [_mm512_setzero_si512(); 3],
+                grads: [[_mm512_setzero_pd(); 3]; 8],
             }
         }
     }
 
-    /// The gradients `(gx, gy, gz)` of the eight corners of the cells `(ix, iy, iz)`, as masks
-    /// ([`gradient_masks`]), in the order `000, 100, 010, 110, 001, 101, 011, 111` (bits x, y,
+    /// The parts of a group's corner keys: the four `x ^ y` (seeded) pairs and the two `z`
+    /// terms, each corner's key `x ^ y ^ z` (xor is associative: any grouping gives the same
+    /// bits as the scalar `corner_hash` input).
+    struct CornerKeys {
+        k00: __m512i,
+        k10: __m512i,
+        k01: __m512i,
+        k11: __m512i,
+        z0: __m512i,
+        z1: __m512i,
+    }
+
+    impl CornerKeys {
+        #[inline(always)]
+        unsafe fn new(ix: __m512i, iy: __m512i, iz: __m512i, seed: __m512i) -> CornerKeys {
+            let x0 = _mm512_mullo_epi64(ix, _mm512_set1_epi64(LATTICE_X as i64));
+            let y0 = _mm512_mullo_epi64(iy, _mm512_set1_epi64(LATTICE_Y as i64));
+            let z0 = _mm512_mullo_epi64(iz, _mm512_set1_epi64(LATTICE_Z as i64));
+            let x1 = _mm512_add_epi64(x0, _mm512_set1_epi64(LATTICE_X as i64));
+            let y1 = _mm512_add_epi64(y0, _mm512_set1_epi64(LATTICE_Y as i64));
+            let z1 = _mm512_add_epi64(z0, _mm512_set1_epi64(LATTICE_Z as i64));
+            let (y0, y1) = (_mm512_xor_si512(y0, seed), _mm512_xor_si512(y1, seed));
+            CornerKeys {
+                k00: _mm512_xor_si512(x0, y0),
+                k10: _mm512_xor_si512(x1, y0),
+                k01: _mm512_xor_si512(x0, y1),
+                k11: _mm512_xor_si512(x1, y1),
+                z0,
+                z1,
+            }
+        }
+    }
+
+    /// The gradient index (the top four bits of `corner_hash`) of the corner with key parts
+    /// `xy` and `z`.
+    #[inline(always)]
+    unsafe fn corner_index(xy: __m512i, z: __m512i) -> __m512i {
+        let key = _mm512_xor_si512(xy, z);
+        let h = _mm512_mullo_epi64(
+            _mm512_xor_si512(key, _mm512_srli_epi64::<32>(key)),
+            _mm512_set1_epi64(FINAL_MUL as i64),
+        );
+        _mm512_srli_epi64::<60>(h)
+    }
+
+    /// The gradients `(gx, gy, gz)` of the eight corners of the cells `(ix, iy, iz)`, in the order `000, 100, 010, 110, 001, 101, 011, 111` (bits x, y,
     /// z): each corner's key hashed (`corner_hash`) and its top four bits looked up in the
     /// gradient tables.
     #[inline(always)]
-    unsafe fn corner_gradients(ix: __m512i, iy: __m512i, iz: __m512i, seed: __m512i) -> [[__m512i; 3]; 8] {
-        let x0 = _mm512_mullo_epi64(ix, _mm512_set1_epi64(LATTICE_X as i64));
-        let y0 = _mm512_mullo_epi64(iy, _mm512_set1_epi64(LATTICE_Y as i64));
-        let z0 = _mm512_mullo_epi64(iz, _mm512_set1_epi64(LATTICE_Z as i64));
-        let x1 = _mm512_add_epi64(x0, _mm512_set1_epi64(LATTICE_X as i64));
-        let y1 = _mm512_add_epi64(y0, _mm512_set1_epi64(LATTICE_Y as i64));
-        let z1 = _mm512_add_epi64(z0, _mm512_set1_epi64(LATTICE_Z as i64));
-        let (y0, y1) = (_mm512_xor_si512(y0, seed), _mm512_xor_si512(y1, seed));
-        let (tx, ty, tz) = (MaskTable::new(&MX), MaskTable::new(&MY), MaskTable::new(&MZ));
-        // The corner keys `x ^ y ^ z` (xor is associative: any grouping gives the same bits),
-        // sharing the four `x ^ y` pairs.
-        let (k00, k10) = (_mm512_xor_si512(x0, y0), _mm512_xor_si512(x1, y0));
-        let (k01, k11) = (_mm512_xor_si512(x0, y1), _mm512_xor_si512(x1, y1));
+    unsafe fn corner_gradients(ix: __m512i, iy: __m512i, iz: __m512i, seed: __m512i) -> [[__m512d; 3]; 8] {
+        let k = CornerKeys::new(ix, iy, iz, seed);
+        let (tx, ty, tz) = (Table::new(&GX), Table::new(&GY), Table::new(&GZ));
         // (Macros, not closures: a closure would be compiled without the kernel's features.)
         macro_rules! grad {
             ($xy:expr, $z:expr) => {{
-                let key = _mm512_xor_si512($xy, $z);
-                let h = _mm512_mullo_epi64(
-                    _mm512_xor_si512(key, _mm512_srli_epi64::<32>(key)),
-                    _mm512_set1_epi64(FINAL_MUL as i64),
-                );
-                let idx = _mm512_srli_epi64::<60>(h);
+                let idx = corner_index($xy, $z);
                 [tx.get(idx), ty.get(idx), tz.get(idx)]
             }};
         }
         [
-            grad!(k00, z0),
-            grad!(k10, z0),
-            grad!(k01, z0),
-            grad!(k11, z0),
-            grad!(k00, z1),
-            grad!(k10, z1),
-            grad!(k01, z1),
-            grad!(k11, z1),
+            grad!(k.k00, k.z0),
+            grad!(k.k10, k.z0),
+            grad!(k.k01, k.z0),
+            grad!(k.k11, k.z0),
+            grad!(k.k00, k.z1),
+            grad!(k.k10, k.z1),
+            grad!(k.k01, k.z1),
+            grad!(k.k11, k.z1),
         ]
     }
 
-    /// The eight lanes' values from their corner gradients (as masks) and fractions: each
-    /// corner's `(gx dx + gy dy) + gz dz` (the products by [`times_gradient`]), the fades, the trilinear blend and the scale, in the scalar
-    /// order.
+    /// The eight lanes' values from their corner gradients and fractions: each corner's
+    /// [`dot`], the fades, the trilinear blend and the scale, in the scalar order.
     #[inline(always)]
-    unsafe fn eval_gradients(g: &[[__m512i; 3]; 8], fx: __m512d, fy: __m512d, fz: __m512d) -> __m512d {
+    unsafe fn eval_gradients(g: &[[__m512d; 3]; 8], fx: __m512d, fy: __m512d, fz: __m512d) -> __m512d {
         let one = _mm512_set1_pd(1.0);
         let (gx, gy, gz) = (_mm512_sub_pd(fx, one), _mm512_sub_pd(fy, one), _mm512_sub_pd(fz, one));
-        macro_rules! dot {
-            ($g:expr, $dx:expr, $dy:expr, $dz:expr) => {{
-                let g = $g;
-                let xy = _mm512_add_pd(times_gradient($dx, g[0]), times_gradient($dy, g[1]));
-                _mm512_add_pd(xy, times_gradient($dz, g[2]))
-            }};
-        }
-        let n000 = dot!(g[0], fx, fy, fz);
-        let n100 = dot!(g[1], gx, fy, fz);
-        let n010 = dot!(g[2], fx, gy, fz);
-        let n110 = dot!(g[3], gx, gy, fz);
-        let n001 = dot!(g[4], fx, fy, gz);
-        let n101 = dot!(g[5], gx, fy, gz);
-        let n011 = dot!(g[6], fx, gy, gz);
-        let n111 = dot!(g[7], gx, gy, gz);
+        let n000 = dot(g[0], fx, fy, fz);
+        let n100 = dot(g[1], gx, fy, fz);
+        let n010 = dot(g[2], fx, gy, fz);
+        let n110 = dot(g[3], gx, gy, fz);
+        let n001 = dot(g[4], fx, fy, gz);
+        let n101 = dot(g[5], gx, fy, gz);
+        let n011 = dot(g[6], fx, gy, gz);
+        let n111 = dot(g[7], gx, gy, gz);
         let (u, v, w) = (fade(fx), fade(fy), fade(fz));
         let a = lerp(v, lerp(u, n000, n100), lerp(u, n010, n110));
         let b = lerp(v, lerp(u, n001, n101), lerp(u, n011, n111));
