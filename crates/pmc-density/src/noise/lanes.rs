@@ -725,9 +725,9 @@ pub(crate) mod x86 {
         _mm512_srli_epi64::<60>(h)
     }
 
-    /// The gradients `(gx, gy, gz)` of the eight corners of the cells `(ix, iy, iz)`, in the order `000, 100, 010, 110, 001, 101, 011, 111` (bits x, y,
-    /// z): each corner's key hashed (`corner_hash`) and its top four bits looked up in the
-    /// gradient tables.
+    /// The gradients `(gx, gy, gz)` of the eight corners of the cells `(ix, iy, iz)`, in the
+    /// order `000, 100, 010, 110, 001, 101, 011, 111` (bits x, y, z): each corner's key hashed
+    /// (`corner_hash`) and its top four bits looked up in the gradient tables.
     #[inline(always)]
     unsafe fn corner_gradients(ix: __m512i, iy: __m512i, iz: __m512i, seed: __m512i) -> [[__m512d; 3]; 8] {
         let k = CornerKeys::new(ix, iy, iz, seed);
