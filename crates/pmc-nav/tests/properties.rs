@@ -135,6 +135,47 @@ fn components_partition_the_nodes_and_steps_stay_inside_them() {
     );
 }
 
+/// The components are exactly the nodes joined by steps (either way), labelled in order of
+/// their first node: no two components a step joins, and no component whose nodes no steps
+/// join (a union-find over every node's steps is the reference).
+#[test]
+fn components_are_exactly_the_nodes_joined_by_steps() {
+    for (kind, seed) in [
+        (PresetKind::Moon, 2),
+        (PresetKind::Mars, 88),
+        (PresetKind::Earthlike, 7),
+    ] {
+        let p = planet(kind, seed);
+        let g = NavGrid::build(p.density().as_ref(), p.layout(), Agent::default()).unwrap();
+        let n = g.node_count();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn find(parent: &mut [u32], mut x: u32) -> u32 {
+            while parent[x as usize] != x {
+                parent[x as usize] = parent[parent[x as usize] as usize];
+                x = parent[x as usize];
+            }
+            x
+        }
+        for id in all_nodes(&g) {
+            for s in g.steps(id) {
+                let (a, b) = (find(&mut parent, id.0), find(&mut parent, s.to.0));
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+        let mut label = vec![u32::MAX; n];
+        let mut next = 0;
+        for id in all_nodes(&g) {
+            let r = find(&mut parent, id.0) as usize;
+            if label[r] == u32::MAX {
+                label[r] = next;
+                next += 1;
+            }
+            assert_eq!(g.component(id), Some(label[r]), "{kind:?} seed {seed}, {id:?}");
+        }
+        assert_eq!(g.component_sizes().len(), next as usize, "{kind:?} seed {seed}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 6, ..ProptestConfig::default() })]
 

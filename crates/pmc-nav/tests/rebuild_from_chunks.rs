@@ -36,6 +36,28 @@ fn every_tile_of_the_default_planet_read_from_its_chunks_is_the_tile_sampled_dir
     assert_same(&g, default_grid());
 }
 
+/// Regression: a column one step from its face's border line, where that line belongs to the
+/// next face, counted as inside its tile. Its steps across the face edge were missing from the
+/// tile's border steps, and the tile from the neighbours of the tile across the edge, so a
+/// rebuild after an edit on the face kept that tile's stale link into it and joined two
+/// components a fresh build keeps apart (Mars, seed 88: one component of 1538 nodes instead of
+/// 1533 and 5).
+#[test]
+fn a_rebuild_relinks_the_tiles_across_a_face_edge_the_next_face_owns() {
+    let layout = Layout::new(2, 8, 100.0, 2.0, 2).unwrap();
+    let mut planet = Planet::new(PresetKind::Mars, 88, layout).with_base_cache(256);
+    let mut g = NavGrid::build(planet.density().as_ref(), planet.layout(), Agent::default()).unwrap();
+    let centre = DVec3::X * (planet.terrain().sea_radius.unwrap_or(120.0) + 1.0);
+    let op = BrushOp::new(BrushKind::Add, centre, 12.517_015_610_846_8, 1.0).unwrap();
+    planet.set_edits(EditSnapshot::from(vec![op]));
+    let mut by_density = g.clone();
+    g.rebuild_for_from(&planet, &op);
+    by_density.rebuild_for(planet.density().as_ref(), &op);
+    let fresh = NavGrid::build(planet.density().as_ref(), planet.layout(), Agent::default()).unwrap();
+    assert_same(&g, &fresh);
+    assert_same(&by_density, &fresh);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 

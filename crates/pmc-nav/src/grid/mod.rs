@@ -210,6 +210,13 @@ impl NavGrid {
 
     /// Whether canonical column `c` of tile `t` lies on the tile's edge: the columns inside it
     /// have their four neighbours on the same face, one grid step away, in the same tile.
+    ///
+    /// A column strictly inside the tile's span but one step from a border line of its face
+    /// that another face owns (the line's columns are canonical there, so in that face's tiles)
+    /// is on the edge too: its step onto the line leaves the tile. Counting it as inside hid
+    /// that step from the tile's border steps, and the tile from the neighbours of the tile
+    /// across the face edge ([`NavGrid::neighbour_tiles`]), so a rebuild kept that tile's stale
+    /// links.
     fn on_tile_edge(&self, t: usize, c: u32) -> bool {
         let n_c = i64::from(self.columns.layout().n_c());
         let (n, n_t) = (self.columns.face_tiles(), i64::from(self.columns.layout().n_t()));
@@ -217,7 +224,14 @@ impl NavGrid {
         let span = |x: i64| (x * n_t, if x == n_c - 1 { n } else { x * n_t + n_t - 1 });
         let place = self.columns.place_of(c);
         let ((ilo, ihi), (jlo, jhi)) = (span(ti), span(tj));
-        !(place.i > ilo && place.i < ihi && place.j > jlo && place.j < jhi)
+        if !(place.i > ilo && place.i < ihi && place.j > jlo && place.j < jhi) {
+            return true;
+        }
+        let off_face = |i: i64, j: i64| !self.columns.is_canonical(ColumnPlace { face: place.face, i, j });
+        (place.i == 1 && off_face(0, place.j))
+            || (place.i == n - 1 && off_face(n, place.j))
+            || (place.j == 1 && off_face(place.i, 0))
+            || (place.j == n - 1 && off_face(place.i, n))
     }
 
     /// The tile that owns a canonical column place.
