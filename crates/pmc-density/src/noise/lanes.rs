@@ -575,19 +575,25 @@ pub(crate) mod x86 {
                 dot([tx.get(idx), ty.get(idx), tz.get(idx)], $dx, $dy, $dz)
             }};
         }
-        let k = &keys;
-        let n000 = corner!(k.k00, k.z0, fx, fy, fz);
-        let n100 = corner!(k.k10, k.z0, gx, fy, fz);
-        let l00 = lerp(u, n000, n100);
-        let n010 = corner!(k.k01, k.z0, fx, gy, fz);
-        let n110 = corner!(k.k11, k.z0, gx, gy, fz);
-        let a = lerp(v, l00, lerp(u, n010, n110));
-        let n001 = corner!(k.k00, k.z1, fx, fy, gz);
-        let n101 = corner!(k.k10, k.z1, gx, fy, gz);
-        let l01 = lerp(u, n001, n101);
-        let n011 = corner!(k.k01, k.z1, fx, gy, gz);
-        let n111 = corner!(k.k11, k.z1, gx, gy, gz);
-        let b = lerp(v, l01, lerp(u, n011, n111));
+        // One layer of four corners (`z` the layer's key part, `dz` its offset), blended along
+        // x, then y.
+        macro_rules! layer {
+            ($z:expr, $dz:expr) => {{
+                let l0 = lerp(
+                    u,
+                    corner!(keys.k00, $z, fx, fy, $dz),
+                    corner!(keys.k10, $z, gx, fy, $dz),
+                );
+                let l1 = lerp(
+                    u,
+                    corner!(keys.k01, $z, fx, gy, $dz),
+                    corner!(keys.k11, $z, gx, gy, $dz),
+                );
+                lerp(v, l0, l1)
+            }};
+        }
+        let a = layer!(keys.z0, fz);
+        let b = layer!(keys.z1, gz);
         _mm512_mul_pd(lerp(w, a, b), _mm512_set1_pd(SCALE))
     }
 
