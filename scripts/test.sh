@@ -14,16 +14,23 @@ if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 fi
 
-step "install the viewer's packages, and Chromium for its end-to-end tests"
+step "install the viewer's packages, Chromium for its end-to-end tests, and the real Earth's data"
 if [ ! -d viewer/node_modules ]; then
   (cd viewer && npm ci --no-audit --no-fund --loglevel=error)
 fi
-if ! command -v chromium >/dev/null 2>&1; then
+# Debian packages: chromium (the end-to-end tests), ferret-datasets (NOAA's ETOPO5 and ETOPO20
+# relief, read by the data-kept tests) and xplanet-images (NASA's Visible Earth, the imagery
+# tests and pictures).
+missing=()
+command -v chromium >/dev/null 2>&1 || missing+=(chromium)
+[ -f /usr/share/ferret-vis/data/etopo5.cdf ] || missing+=(ferret-datasets)
+[ -f /usr/share/xplanet/images/earth.jpg ] || missing+=(xplanet-images)
+if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ]; then
     apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"
   else
-    echo "the end-to-end tests need Debian's chromium: sudo apt-get install chromium" >&2
+    echo "the tests need Debian's ${missing[*]}: sudo apt-get install ${missing[*]}" >&2
     exit 1
   fi
 fi

@@ -17,8 +17,11 @@ pub struct DemArgs {
 
 #[derive(Subcommand, Debug)]
 enum DemCommand {
-    /// Reproject an equirectangular elevation model (netCDF classic such as NOAA ETOPO, GeoTIFF,
-    /// or a 16-bit PNG with --extent) onto six cube faces of 2^n + 1 samples: one .pmcdem file.
+    /// Import an equirectangular elevation model (netCDF classic such as NOAA ETOPO, GeoTIFF,
+    /// or a 16-bit PNG with --extent) into one .pmcdem file: the grid itself, from which heights
+    /// are interpolated (equal to the data at every data point), and its reprojection onto six
+    /// cube faces of 2^n + 1 samples. Then reports, over every data point, how far the planet's
+    /// height lies from the data (max, 99th percentile, RMS) and the file's size.
     Import(ImportArgs),
     /// Describe a .pmcdem file: its source, levels and the storage table (size and metres per
     /// sample at each level).
@@ -66,8 +69,10 @@ struct ImportArgs {
     /// netCDF: the variable holding the heights [default: the only 2-D grid with coordinates].
     #[arg(long, value_name = "NAME")]
     variable: Option<String>,
-    /// Data level n: faces of 2^n + 1 samples a side [default: the smallest n whose spacing at
-    /// a face's centre is at most the input's at the equator].
+    /// Data level n: faces of 2^n + 1 samples a side, and the spacing of the coarsest detail
+    /// octave [default: the smallest n whose spacing at a face's centre is at most the input's at
+    /// the equator]. Heights come from the input grid itself at any level: the level does not
+    /// change them at the data points.
     #[arg(long, value_name = "N")]
     level: Option<u32>,
     /// Sample format.
@@ -80,7 +85,7 @@ struct ImportArgs {
     #[arg(long = "memory-mb", value_name = "MB", default_value_t = 512)]
     memory_mb: usize,
     /// PNG: the extent WEST,SOUTH,EAST,NORTH in degrees (cell edges).
-    #[arg(long, value_name = "W,S,E,N", allow_negative_numbers = true)]
+    #[arg(long, value_name = "W,S,E,N", allow_hyphen_values = true)]
     extent: Option<String>,
     /// PNG: metres per unit of the 16-bit value.
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
@@ -97,6 +102,17 @@ struct ImportArgs {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Skip the check of the heights at every data point (a few seconds for ETOPO5).
+    #[arg(long)]
+    no_check: bool,
+    /// Print the report as JSON on standard output.
+    #[arg(long)]
+    json: bool,
+    /// Also import this colour image (JPEG, PNG or GeoTIFF; the whole globe unless a GeoTIFF
+    /// says otherwise) into imagery beside the output: the same name with extension .pmcimg
+    /// (see `pmc imagery import`, which also takes an extent).
+    #[arg(long, value_name = "IMAGE")]
+    imagery: Option<PathBuf>,
 }
 
 /// `pmc dem info`.
@@ -183,6 +199,10 @@ fn parse_extent(s: &str) -> Result<[f64; 4], CliError> {
 }
 
 fn import(a: &ImportArgs) -> Result<(), CliError> {
+    // The imagery is read first, so that a bad image fails before the long import.
+    let imagery = (a.imagery.as_deref())
+        .map(|p| crate::imagery::read_image(p, None))
+        .transpose()?;
     let format = match a.format {
         Some(f) => f,
         None => sniff(&a.input)?,
@@ -254,9 +274,10 @@ fn import(a: &ImportArgs) -> Result<(), CliError> {
         })
         .map_err(dem_error)?;
     bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
     if !a.quiet {
         eprintln!(
-            "imported {} ({} x {}) into {}: level {} ({} samples a face side), {:?}, {} samples filled, {:.1} MB in {:.2} s; digest {}",
+            "imported {} ({} x {}) into {}: level {} ({} samples a face side), {:?}, {} samples filled, {:.1} MB (source grid {:.1} MB) in {:.2} s; digest {}",
             source.name(),
             source.width(),
             source.height(),
@@ -264,11 +285,66 @@ fn import(a: &ImportArgs) -> Result<(), CliError> {
             report.level,
             (1u64 << report.level) + 1,
             report.format,
-            report.filled,
+            report.source_filled,
             report.bytes as f64 / 1e6,
-            start.elapsed().as_secs_f64(),
+            report.source_bytes as f64 / 1e6,
+            seconds,
             report.digest
         );
+    }
+    let checks = if a.no_check {
+        Vec::new()
+    } else {
+        let cube = CubeDem::open(&a.output).map_err(dem_error)?;
+        let detail = pmc_dem::DetailNoise::default();
+        [Interpolation::Bilinear, Interpolation::Bicubic]
+            .into_iter()
+            .map(|interp| pool.install(|| pmc_dem::cube::accuracy(&cube, source.as_ref(), interp, &detail)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(dem_error)?
+    };
+    if !a.quiet {
+        for c in &checks {
+            eprintln!(
+                "{:?} heights at the {} data points (detail on): error max {:.3} m, 99th percentile {:.3} m, RMS {:.3} m",
+                c.interpolation, c.samples, c.max, c.p99, c.rms
+            );
+        }
+    }
+    if a.json {
+        let accuracy: Vec<serde_json::Value> = checks
+            .iter()
+            .map(|c| {
+                serde_json::json!({
+                    "interpolation": c.interpolation.to_string(),
+                    "samples": c.samples,
+                    "missing": c.missing,
+                    "max_error_m": c.max,
+                    "p99_error_m": c.p99,
+                    "rms_error_m": c.rms,
+                    "worst": c.worst.map(|w| serde_json::json!({
+                        "lat": w.lat, "lon": w.lon, "value_m": w.value, "height_m": w.height,
+                    })),
+                })
+            })
+            .collect();
+        let out = serde_json::json!({
+            "output": a.output.display().to_string(),
+            "source": source.name(),
+            "width": source.width(),
+            "height": source.height(),
+            "level": report.level,
+            "bytes": report.bytes,
+            "source_bytes": report.source_bytes,
+            "source_filled": report.source_filled,
+            "seconds": seconds,
+            "digest": report.digest,
+            "accuracy": accuracy,
+        });
+        println!("{}", serde_json::to_string_pretty(&out).expect("JSON"));
+    }
+    if let (Some(img), Some(input)) = (&imagery, &a.imagery) {
+        crate::imagery::write_image(img, input, &crate::imagery::beside(&a.output), a.quiet)?;
     }
     Ok(())
 }
@@ -303,6 +379,11 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
             "format": format!("{:?}", dem.format()),
             "digest": dem.digest(),
             "filled_samples": dem.filled_samples(),
+            "source_extent": dem.source_extent(),
+            "version": dem.version(),
+            "source_grid": dem.source_size().map(|(w, h)| serde_json::json!({
+                "width": w, "height": h, "bytes": dem.source_bytes(),
+            })),
             "value_range": [lo, hi],
             "verified": a.verify,
             "levels": rows,
@@ -312,6 +393,8 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
     }
     println!("file         {}", a.file.display());
     println!("source       {}", dem.source_name());
+    let [west, east, south, north] = dem.source_extent();
+    println!("extent       {west}..{east} E, {south}..{north} N (degrees, sample positions)");
     println!("body radius  {} m", dem.radius());
     println!(
         "data level   {} ({} samples a face side), {:?} samples, {} filled",
@@ -320,6 +403,17 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
         dem.format(),
         dem.filled_samples()
     );
+    match dem.source_size() {
+        Some((w, h)) => println!(
+            "source grid  {w} x {h} samples, {} (heights interpolated from it: version {})",
+            human(dem.source_bytes()),
+            dem.version()
+        ),
+        None => println!(
+            "source grid  not kept (version {}: heights interpolated from the faces)",
+            dem.version()
+        ),
+    }
     println!("heights      {lo} m to {hi} m");
     println!("digest       {}", dem.digest());
     if a.verify {

@@ -54,6 +54,10 @@ pub enum CliError {
     /// the problem).
     #[error("{0}")]
     Dem(String),
+    /// Imagery could not be imported, read or written (the message names the file and the
+    /// problem).
+    #[error(transparent)]
+    Imagery(#[from] pmc_imagery::ImageryError),
     /// Invalid `pmc edit` options, or planet options that disagree with the world file.
     #[error("{0}")]
     Edit(String),
@@ -81,12 +85,15 @@ impl CliError {
             | CliError::Region(_)
             | CliError::Host(_) => 2,
             CliError::Serve(pmc_server::ServerError::Config(_)) => 2,
+            CliError::Serve(pmc_server::ServerError::Imagery(e)) if e.is_input_error() => 2,
             CliError::Serve(_) => 1,
             CliError::Render(pmc_render::RenderError::Io { .. } | pmc_render::RenderError::Png { .. }) => 1,
             CliError::Render(_) => 2,
             CliError::Export(_) | CliError::Threads { .. } => 1,
             CliError::World(pmc_world::WorldError::Io { .. } | pmc_world::WorldError::Sqlite { .. }) => 1,
             CliError::World(_) | CliError::Brush(_) | CliError::Edit(_) | CliError::Dem(_) => 2,
+            CliError::Imagery(e) if e.is_input_error() => 2,
+            CliError::Imagery(_) => 1,
         }
     }
 }

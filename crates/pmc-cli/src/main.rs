@@ -6,6 +6,7 @@ mod edit;
 mod error;
 mod flight;
 mod generate;
+mod imagery;
 mod info;
 mod path;
 mod planet_args;
@@ -44,6 +45,9 @@ enum Command {
     /// Real planets: import elevation models (netCDF, GeoTIFF, 16-bit PNG) onto the cube faces,
     /// describe the files, probe the surface at a place.
     Dem(dem::DemArgs),
+    /// Imagery draped on a planet: import a colour image (JPEG, PNG, GeoTIFF) into a .pmcimg
+    /// file for `pmc serve --imagery`, describe the file, look up its colour at a place.
+    Imagery(imagery::ImageryArgs),
 }
 
 fn main() -> ExitCode {
@@ -70,6 +74,7 @@ fn main() -> ExitCode {
         Command::Path(a) => path::run(a),
         Command::BenchFlight(a) => flight::run(a),
         Command::Dem(a) => dem::run(a),
+        Command::Imagery(a) => imagery::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -56,6 +56,11 @@ pub struct ServeArgs {
     /// Edits one client address may send at once before --edit-rate applies (with --world).
     #[arg(long = "edit-burst", default_value_t = EditLimits::default().burst, value_name = "N")]
     edit_burst: u32,
+
+    /// Drape this imagery (a .pmcimg file made by `pmc imagery import`) on the planet: the
+    /// viewer colours the terrain from it (GET /api/v1/imagery).
+    #[arg(long, value_name = "FILE.pmcimg")]
+    imagery: Option<PathBuf>,
 }
 
 /// Parses `--host`: an IP address or "localhost" (no name lookups).
@@ -89,6 +94,7 @@ pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliErro
         cache_bytes: args.cache_mb.saturating_mul(1 << 20),
         threads: args.threads,
         world: args.world.clone(),
+        imagery: args.imagery.clone(),
         edit_limits: EditLimits {
             max_brush_radius: args.max_brush_radius,
             rate_per_second: args.edit_rate,

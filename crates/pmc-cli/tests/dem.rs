@@ -122,6 +122,52 @@ fn import_info_and_probe() {
 }
 
 #[test]
+fn import_reports_the_error_at_every_data_point() {
+    let d = dir("accuracy");
+    let out = d.join("earth.pmcdem");
+    let (json, err) = ok(&[
+        "dem",
+        "import",
+        &fixture("etopo60.cdf"),
+        "-o",
+        s(&out),
+        "--level",
+        "5",
+        "--json",
+    ]);
+    assert!(err.contains("error max") && err.contains("RMS"), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["bytes"].as_u64(), Some(std::fs::metadata(&out).unwrap().len()));
+    assert!(v["source_bytes"].as_u64().unwrap() > 360 * 180 * 2, "{v}");
+    let checks = v["accuracy"].as_array().unwrap();
+    assert_eq!(checks.len(), 2, "bilinear and bicubic");
+    for c in checks {
+        assert_eq!(c["samples"], 360 * 180, "{c}");
+        for key in ["max_error_m", "p99_error_m", "rms_error_m"] {
+            assert!(c[key].as_f64().unwrap() < 1e-6, "{key}: {c}");
+        }
+    }
+    // The check can be skipped.
+    let (json, _) = ok(&[
+        "dem",
+        "import",
+        &fixture("etopo60.cdf"),
+        "-o",
+        s(&out),
+        "--level",
+        "5",
+        "--json",
+        "--no-check",
+        "--quiet",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["accuracy"].as_array().map(Vec::len), Some(0));
+    let (info, _) = ok(&["dem", "info", s(&out)]);
+    assert!(info.contains("source grid  360 x 180 samples"), "{info}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
 fn a_real_planet_is_edited_in_a_world_and_walked_on() {
     let d = dir("world");
     let dem = import_etopo60(&d);
@@ -192,6 +238,27 @@ fn a_real_planet_is_edited_in_a_world_and_walked_on() {
     // another planet under its edits.
     std::fs::copy(&other, &dem).unwrap();
     refused(&["edit", "--world", s(&world), "--list"], "digest");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// `--extent -10,35,5,44` starts with a minus: clap took it for an option ("unexpected argument
+/// '-1'") before the flag accepted values that start with a hyphen.
+#[test]
+fn an_extent_west_of_greenwich_is_read_as_the_extent() {
+    let d = dir("extent-minus");
+    let out = d.join("west.pmcdem");
+    let png = fixture("etopo5deg.png");
+    ok(&[
+        "dem", "import", &png, "-o", s(&out), "--extent", "-10,-5,10,5", "--level", "4", "--quiet",
+    ]);
+    let (info, _) = ok(&["dem", "info", s(&out), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&info).unwrap();
+    let extent: Vec<f64> = serde_json::from_value(v["source_extent"].clone()).unwrap();
+    // west, east, south, north of the samples: cell centres inside the cell edges given
+    assert!(extent[0] > -10.0 && extent[0] < -9.0, "{extent:?}");
+    assert!(extent[1] < 10.0 && extent[1] > 9.0, "{extent:?}");
+    assert!(extent[2] > -5.0 && extent[2] < -4.0, "{extent:?}");
+    assert!(extent[3] < 5.0 && extent[3] > 4.0, "{extent:?}");
     std::fs::remove_dir_all(&d).unwrap();
 }
 

@@ -226,7 +226,7 @@ pub enum DemError {
     /// The `.pmcdem` file has a format version this reader does not know (a newer writer, or a
     /// damaged header). Fix: read it with a newer version of this crate, or import the source
     /// again.
-    #[error("{file}: .pmcdem version {version} is not supported (this reader knows version 1); use a newer reader or import the source again")]
+    #[error("{file}: .pmcdem version {version} is not supported (this reader knows versions 1 and 2); use a newer reader or import the source again")]
     UnsupportedVersion {
         /// The file.
         file: String,

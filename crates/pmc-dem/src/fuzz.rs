@@ -25,12 +25,13 @@ pub struct Target {
 }
 
 /// The files under `tests/fixtures` used as seeds (relative to the crate's directory).
-pub const SEED_FILES: [&str; 5] = [
+pub const SEED_FILES: [&str; 6] = [
     "etopo60.cdf",
     "etopo5deg_i16_deflate.tif",
     "etopo5deg_f32_lzw.tif",
     "etopo5deg_i16_tiled.tif",
     "etopo5deg.png",
+    "etopo60_l6_v1.pmcdem",
 ];
 
 /// The extent given to the PNG reader: the seed's (ETOPO60 every 5 degrees, from 20 east).
@@ -176,6 +177,18 @@ fn parse_pmcdem(bytes: &[u8]) -> bool {
                 ] {
                     let _ = dem.height(d, crate::Interpolation::Bicubic, &detail, 1.0);
                 }
+                // A batch of lattice points (stencils inside source tiles, across their borders
+                // and the antimeridian), and the stored source samples.
+                let points: Vec<pmc_geometry::glam::IVec3> = (0..40)
+                    .filter_map(|k| {
+                        pmc_geometry::face_lattice(pmc_geometry::Face::ALL[k % 6], k as i64 * 97, 1000, 4096)
+                    })
+                    .collect();
+                let mut out = vec![0.0; points.len()];
+                dem.heights_at_lattice(&points, 4096, crate::Interpolation::Bilinear, &detail, &mut out);
+                if let Some((w, h)) = dem.source_size() {
+                    let _ = dem.source_sample(w - 1, h - 1);
+                }
                 match dem.verify() {
                     Ok(()) => true,
                     Err(e) => {
@@ -215,7 +228,8 @@ fn pmcdem_seed(fixtures: &Path) -> std::io::Result<Vec<u8>> {
 
 /// Every reader, with the seed files read from `fixtures` (the crate's `tests/fixtures`): the
 /// netCDF reader whole and windowed on ETOPO60; the GeoTIFF reader whole on strips compressed
-/// with deflate and LZW and on tiles, and windowed on the tiles; the PNG reader.
+/// with deflate and LZW and on tiles, and windowed on the tiles; the PNG reader; the `.pmcdem`
+/// reader on a version 2 file (faces and source grid) and on a version 1 file.
 pub fn targets(fixtures: &Path) -> std::io::Result<Vec<Target>> {
     let read = |name: &str| std::fs::read(fixtures.join(name));
     let cdf = read(SEED_FILES[0])?;
@@ -259,6 +273,11 @@ pub fn targets(fixtures: &Path) -> std::io::Result<Vec<Target>> {
         Target {
             name: "pmcdem",
             seed: pmcdem_seed(fixtures)?,
+            parse: parse_pmcdem,
+        },
+        Target {
+            name: "pmcdem-v1",
+            seed: read(SEED_FILES[5])?,
             parse: parse_pmcdem,
         },
     ])

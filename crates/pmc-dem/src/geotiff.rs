@@ -559,19 +559,32 @@ fn heights(chunk: DecodingResult, nodata: Option<f64>) -> Vec<f32> {
     }
 }
 
-/// Where the pixels lie: longitude of raster x coordinate `i` is `x0 + x_scale * i`, latitude of
-/// raster y coordinate `j` is `y0 + y_scale * j` (raster coordinates: 0 at the outer corner of
-/// the first pixel for PixelIsArea, at its centre for PixelIsPoint).
-struct Georeference {
-    x0: f64,
-    x_scale: f64,
-    y0: f64,
-    y_scale: f64,
-    pixel_is_point: bool,
+/// Where the pixels of a GeoTIFF lie: longitude of raster x coordinate `i` is
+/// `x0 + x_scale * i`, latitude of raster y coordinate `j` is `y0 + y_scale * j` (raster
+/// coordinates: 0 at the outer corner of the first pixel for PixelIsArea, at its centre for
+/// PixelIsPoint). Read by [`GeoTiffSource`] and by other readers of georeferenced TIFF files
+/// (colour imagery), so that both accept the same tags.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Georeference {
+    /// Longitude of raster x coordinate 0, degrees.
+    pub x0: f64,
+    /// Degrees of longitude per pixel (finite, nonzero; negative when columns run west).
+    pub x_scale: f64,
+    /// Latitude of raster y coordinate 0, degrees.
+    pub y0: f64,
+    /// Degrees of latitude per pixel (finite, nonzero; negative when rows run south, as usual).
+    pub y_scale: f64,
+    /// Whether pixels are points (GTRasterTypeGeoKey 2) rather than areas.
+    pub pixel_is_point: bool,
 }
 
 impl Georeference {
-    fn read(file: &str, decoder: &mut Decoder<Box<dyn Input>>, len: u64) -> Result<Georeference, DemError> {
+    /// Reads the georeferencing tags of the TIFF that `decoder` reads (see [`GeoTiffSource`] for
+    /// those accepted); `file` names it in errors and `len` is its length in bytes.
+    ///
+    /// Errors: [`DemError::NoGeoreference`], [`DemError::NotGeographic`], and the TIFF errors
+    /// ([`DemError::TiffCorrupt`], [`DemError::Truncated`], ...) of reading the tags.
+    pub fn read<R: Read + Seek>(file: &str, decoder: &mut Decoder<R>, len: u64) -> Result<Georeference, DemError> {
         let no_geo = |detail: String| DemError::NoGeoreference {
             file: file.to_owned(),
             detail,

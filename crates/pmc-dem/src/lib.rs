@@ -1,7 +1,7 @@
 //! Digital elevation models: equirectangular grids read from netCDF classic, GeoTIFF and 16-bit
 //! PNG files (heights in metres at evenly spaced longitudes and latitudes, with bilinear sampling
-//! that wraps round the globe), and cube-face `.pmcdem` files made from them (see "Cube-face
-//! files" below).
+//! that wraps round the globe), and `.pmcdem` files made from them (see "Elevation files"
+//! below).
 //!
 //! [`EquirectDem::read_netcdf`] reads a netCDF classic (CDF-1) or 64-bit offset (CDF-2) file such
 //! as NOAA's ETOPO relief grids; [`EquirectDem::read_geotiff`] a single-band GeoTIFF in
@@ -36,18 +36,20 @@
 //! # Ok::<(), pmc_dem::DemError>(())
 //! ```
 //!
-//! # Cube-face files
+//! # Elevation files
 //!
-//! [`import_cube`] reprojects any [`EquirectSource`] once onto the six faces of the cube-sphere
-//! and writes a `.pmcdem` file (spec: `docs/specs/pmcdem-v1.md`): `2^n + 1` samples a face
-//! side with bit-identical shared edges, decimated overviews down to 65 samples, checksummed
-//! tiles, read in bands of rows within a memory budget. [`CubeDem`] reads it tile by tile
-//! (a bounded cache, `Send + Sync`) and gives heights anywhere: interpolated data, exact at the
-//! data samples, plus [`DetailNoise`] octaves below the data resolution that are exactly zero at
-//! the samples (seed 003 Sec. 4.5, 4.6).
+//! [`import_cube`] writes a `.pmcdem` file (spec: `docs/specs/pmcdem-v2.md`) from any
+//! [`EquirectSource`]: the source grid itself in checksummed tiles, and its reprojection onto
+//! the six faces of the cube-sphere (`2^n + 1` samples a face side with bit-identical shared
+//! edges, decimated overviews down to 65 samples), read in bands of rows within a memory budget.
+//! [`CubeDem`] reads it tile by tile (a bounded cache, `Send + Sync`) and gives heights anywhere:
+//! the source grid interpolated in its own index space, **exact at every source sample**, plus
+//! [`DetailNoise`] octaves below the data resolution that fade to zero at every source sample
+//! (seed 003 Sec. 4.5, 4.6). [`cube::accuracy`] measures that over every source sample. Version
+//! 1 files (`docs/specs/pmcdem-v1.md`, cube faces only) are still read.
 //!
 //! ```
-//! use pmc_dem::cube::{import_cube, CubeDem, DetailNoise, ImportOptions, Interpolation};
+//! use pmc_dem::cube::{accuracy, import_cube, CubeDem, DetailNoise, ImportOptions, Interpolation};
 //! use pmc_dem::EquirectDem;
 //! use pmc_geometry::{glam::IVec3, LatLon};
 //!
@@ -65,10 +67,18 @@
 //! let everest = LatLon::new(28.0, 87.0).unwrap().to_unit();
 //! let h = cube.height(everest, Interpolation::Bicubic, &detail, 10.0);
 //! assert!(h > 2000.0, "{h}");
-//! // A data sample (the centre of the South face, resolution 64) is returned exactly.
+//! // Every source sample is kept: here at cell (3, 4) of the one-degree grid.
+//! let (lat, lon) = (dem.lat(4), dem.lon(3));
+//! let at = LatLon::new(lat, lon).unwrap().to_unit();
+//! let kept = cube.height(at, Interpolation::Bicubic, &detail, 1.0);
+//! assert!((kept - f64::from(dem.value(3, 4).unwrap())).abs() < 1e-6);
+//! // And over all of them.
+//! let check = accuracy(&cube, &dem, Interpolation::Bilinear, &detail)?;
+//! assert!(check.max < 1e-6 && check.samples == 360 * 180);
+//! // A lattice point has the same height at every resolution that holds it.
 //! let centre = IVec3::new(0, 0, 64);
-//! let stored = cube.sample(0, pmc_geometry::Face::South, 32, 32)?;
-//! assert_eq!(cube.height_at_lattice(centre, 64, Interpolation::Bilinear, &detail), f64::from(stored));
+//! let coarse = cube.height_at_lattice(centre, 64, Interpolation::Bilinear, &detail);
+//! assert_eq!(coarse, cube.height_at_lattice(centre * 4, 256, Interpolation::Bilinear, &detail));
 //! # std::fs::remove_file(&out).unwrap();
 //! # Ok::<(), pmc_dem::DemError>(())
 //! ```
@@ -93,7 +103,7 @@ mod terrain;
 mod netcdf_source;
 pub use netcdf_source::NetcdfSource;
 mod geotiff;
-pub use geotiff::{GeoTiffSource, MAX_CHUNK_ROW_CELLS};
+pub use geotiff::{GeoTiffSource, Georeference, MAX_CHUNK_ROW_CELLS};
 mod png16;
 pub use png16::PngExtent;
 pub mod fuzz;

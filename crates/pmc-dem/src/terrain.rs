@@ -58,7 +58,7 @@ impl DemHeights {
     }
 
     /// The height at the canonical lattice point `lattice` of resolution `m` (see
-    /// [`CubeDem::height_at_lattice`]): exact at data samples, with the detail octaves coarser
+    /// [`CubeDem::height_at_lattice`]): exact at the data's samples, with the detail octaves coarser
     /// than the point's spacing. A pure, scale-invariant function of the point: what a
     /// height-field mesher needs of its heights.
     pub fn height_at_lattice(&self, lattice: pmc_geometry::glam::IVec3, m: i32) -> f64 {
@@ -108,13 +108,25 @@ pub struct NearestSample {
     pub distance: f64,
 }
 
-/// The finest-level sample of `dem` nearest to the unit direction `dir` (on the face `dir`
-/// projects onto).
+/// The data sample of `dem` nearest to the unit direction `dir`: in a version 2 file the source
+/// sample nearest in column and row; in a version 1 file the finest-level face sample nearest on
+/// the face `dir` projects onto.
 pub fn nearest_sample(dem: &CubeDem, dir: DVec3) -> Result<NearestSample, DemError> {
     let bad = || DemError::OutOfGrid {
         file: dem.path().to_string(),
         detail: format!("no sample near the direction {dir}"),
     };
+    if dem.keeps_source() {
+        let (c, r, lat, lon) = dem.nearest_source_sample(dir).ok_or_else(bad)?;
+        let value = dem.source_sample(c, r)?;
+        let at = pmc_geometry::LatLon::new(lat.clamp(-90.0, 90.0), lon).map_err(|_| bad())?;
+        return Ok(NearestSample {
+            lat: at.lat,
+            lon: at.lon,
+            value,
+            distance: at.to_unit().angle_between(dir.normalize()) * dem.radius(),
+        });
+    }
     let (face, u, v) = pmc_geometry::sphere_to_face_uv(dir).ok_or_else(bad)?;
     let n = f64::from(1u32 << dem.data_level());
     let index = |x: f64| ((x + 1.0) * 0.5 * n).round().clamp(0.0, n) as u32;

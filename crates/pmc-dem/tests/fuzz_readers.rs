@@ -11,7 +11,7 @@ fn fixtures() -> std::path::PathBuf {
 #[test]
 fn a_short_fuzz_run_finds_no_panic_in_any_reader() {
     let targets = fuzz::targets(&fixtures()).unwrap();
-    assert_eq!(targets.len(), 8);
+    assert_eq!(targets.len(), 9);
     let reports = fuzz::run(&targets, 800, 0x5EED, None);
     let panics: Vec<_> = reports
         .iter()
@@ -19,7 +19,7 @@ fn a_short_fuzz_run_finds_no_panic_in_any_reader() {
         .map(|r| (r.name, r.panics.clone()))
         .collect();
     assert!(panics.is_empty(), "{panics:?}");
-    assert_eq!(reports.iter().map(|r| r.executions).sum::<u64>(), 6400);
+    assert_eq!(reports.iter().map(|r| r.executions).sum::<u64>(), 9 * 800);
 }
 
 #[test]

@@ -1,15 +1,21 @@
-//! The `.pmcdem` v1 byte layout: header, tile table, level and tile geometry
-//! (`docs/specs/pmcdem-v1.md`).
+//! The `.pmcdem` byte layout: header, tile table, level and tile geometry, and the v2 source
+//! grid section (`docs/specs/pmcdem-v1.md`, `docs/specs/pmcdem-v2.md`).
 
 use crate::error::DemError;
 
 /// The eight bytes every `.pmcdem` file starts with (a non-ASCII byte, the name, a line feed, as
 /// PNG does, so that text-mode transfers and foreign files are recognised).
 pub const MAGIC: [u8; 8] = [0x89, b'P', b'M', b'C', b'D', b'E', b'M', b'\n'];
-/// The format version written by this crate and the only one it reads.
-pub const VERSION: u32 = 1;
-/// Bytes of the fixed header.
+/// The format version written by this crate. It reads versions 1 (cube faces only) and 2 (cube
+/// faces and the source grid).
+pub const VERSION: u32 = 2;
+/// Bytes of the fixed header of version 1, and of the part of a version 2 header laid out as in
+/// version 1.
 pub const HEADER_BYTES: usize = 512;
+/// Bytes of the fixed header of version 2: the version 1 fields, then the source block.
+pub const HEADER_BYTES_V2: usize = 640;
+/// Samples along a side of a source tile written by [`import_cube`](crate::import_cube).
+pub const DEFAULT_SOURCE_TILE_SIZE: u32 = 64;
 /// Bytes of one tile-table entry.
 pub const ENTRY_BYTES: usize = 24;
 /// The finest data level accepted: `2^16 + 1` samples a face side (about 26 billion samples).
@@ -170,9 +176,81 @@ impl TileGrid {
     }
 }
 
-/// The fixed header (`docs/specs/pmcdem-v1.md`, "Header").
+/// The source grid stored by a version 2 file (`docs/specs/pmcdem-v2.md`, "Source block"): its
+/// axes (rows from south to north, columns from west to east) and its tiles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SourceLayout {
+    pub lon_first: f64,
+    pub lon_step: f64,
+    pub lat_first: f64,
+    pub lat_step: f64,
+    pub width: u32,
+    pub height: u32,
+    pub tile: u32,
+    pub wraps: bool,
+}
+
+/// One source tile: its first column and row and its extent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct SourceTileRef {
+    pub c0: u32,
+    pub r0: u32,
+    pub w: u32,
+    pub h: u32,
+}
+
+impl SourceLayout {
+    /// Tiles along a row of tiles.
+    pub fn tiles_x(&self) -> u32 {
+        self.width.div_ceil(self.tile)
+    }
+    /// Rows of tiles.
+    pub fn tiles_y(&self) -> u32 {
+        self.height.div_ceil(self.tile)
+    }
+    /// Source tiles in all.
+    pub fn total(&self) -> u64 {
+        u64::from(self.tiles_x()) * u64::from(self.tiles_y())
+    }
+    /// The index (among the source tiles, from 0) of the tile holding column `c`, row `r`.
+    #[inline]
+    pub fn index_of(&self, c: u32, r: u32) -> u64 {
+        u64::from(r / self.tile) * u64::from(self.tiles_x()) + u64::from(c / self.tile)
+    }
+    /// Source tile `k` (which must be below `total`).
+    pub fn tile_ref(&self, k: u64) -> SourceTileRef {
+        let tx = (k % u64::from(self.tiles_x())) as u32;
+        let ty = (k / u64::from(self.tiles_x())) as u32;
+        let (c0, r0) = (tx * self.tile, ty * self.tile);
+        SourceTileRef {
+            c0,
+            r0,
+            w: self.tile.min(self.width - c0),
+            h: self.tile.min(self.height - r0),
+        }
+    }
+    /// The block's bytes 512..560 (see the spec); the content digest covers them.
+    pub fn geometry_bytes(&self) -> [u8; 48] {
+        let mut b = [0u8; 48];
+        b[0..8].copy_from_slice(&self.lon_first.to_le_bytes());
+        b[8..16].copy_from_slice(&self.lon_step.to_le_bytes());
+        b[16..24].copy_from_slice(&self.lat_first.to_le_bytes());
+        b[24..32].copy_from_slice(&self.lat_step.to_le_bytes());
+        b[32..36].copy_from_slice(&self.width.to_le_bytes());
+        b[36..40].copy_from_slice(&self.height.to_le_bytes());
+        b[40..44].copy_from_slice(&self.tile.to_le_bytes());
+        b[44] = u8::from(self.wraps);
+        b
+    }
+}
+
+/// The fixed header (`docs/specs/pmcdem-v1.md`, "Header"; version 2 adds the source block).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Header {
+    /// The format version: 1 or 2.
+    pub version: u32,
+    /// Version 2: the stored source grid.
+    pub source: Option<SourceLayout>,
     pub n: u32,
     pub levels: u32,
     pub format: SampleFormat,
@@ -224,11 +302,20 @@ pub(crate) fn truncate_utf8(s: &str, max: usize) -> &str {
 }
 
 impl Header {
-    pub fn encode(&self) -> [u8; HEADER_BYTES] {
-        let mut b = [0u8; HEADER_BYTES];
+    /// Bytes of this header: [`HEADER_BYTES`] in version 1, [`HEADER_BYTES_V2`] in version 2.
+    pub fn len(&self) -> usize {
+        if self.source.is_some() {
+            HEADER_BYTES_V2
+        } else {
+            HEADER_BYTES
+        }
+    }
+
+    pub fn encode(&self) -> Vec<u8> {
+        let mut b = vec![0u8; self.len()];
         b[0..8].copy_from_slice(&MAGIC);
-        put_u32(&mut b, 8, VERSION);
-        put_u32(&mut b, 12, HEADER_BYTES as u32);
+        put_u32(&mut b, 8, self.version);
+        put_u32(&mut b, 12, self.len() as u32);
         b[16] = self.n as u8;
         b[17] = self.levels as u8;
         b[18] = self.format.code();
@@ -260,6 +347,11 @@ impl Header {
         b[224..224 + name.len()].copy_from_slice(name);
         let crc = crc32fast::hash(&b[..508]);
         put_u32(&mut b, 508, crc);
+        if let Some(src) = &self.source {
+            b[512..560].copy_from_slice(&src.geometry_bytes());
+            let crc = crc32fast::hash(&b[512..636]);
+            put_u32(&mut b, 636, crc);
+        }
         b
     }
 
@@ -294,10 +386,18 @@ impl Header {
             });
         }
         let version = get_u32(b, 8);
-        if version != VERSION {
+        if version != 1 && version != 2 {
             return Err(DemError::UnsupportedVersion {
                 file: file.to_owned(),
                 version,
+            });
+        }
+        let header_len = if version == 1 { HEADER_BYTES } else { HEADER_BYTES_V2 };
+        if b.len() < header_len {
+            return Err(DemError::Truncated {
+                file: file.to_owned(),
+                expected: header_len as u64,
+                actual: file_len,
             });
         }
         let crc = crc32fast::hash(&b[..508]);
@@ -307,12 +407,17 @@ impl Header {
                 get_u32(b, 508)
             )));
         }
-        if get_u32(b, 12) != HEADER_BYTES as u32 {
+        if get_u32(b, 12) != header_len as u32 {
             return Err(corrupt(format!(
-                "header length {} (v1 headers are 512 bytes)",
+                "header length {} (v{version} headers are {header_len} bytes)",
                 get_u32(b, 12)
             )));
         }
+        let source = if version == 2 {
+            Some(decode_source_block(b, &corrupt)?)
+        } else {
+            None
+        };
         let n = u32::from(b[16]);
         if !(1..=MAX_DATA_LEVEL).contains(&n) {
             return Err(corrupt(format!("data level {n} (1 to {MAX_DATA_LEVEL} are valid)")));
@@ -357,10 +462,11 @@ impl Header {
         }
         let table_offset = get_u64(b, 88);
         let data_offset = get_u64(b, 96);
-        let table_end = HEADER_BYTES as u64 + tiles * ENTRY_BYTES as u64 + 4;
-        if table_offset != HEADER_BYTES as u64 || data_offset != table_end {
+        let entries = tiles + source.map_or(0, |s| s.total());
+        let table_end = header_len as u64 + entries * ENTRY_BYTES as u64 + 4;
+        if table_offset != header_len as u64 || data_offset != table_end {
             return Err(corrupt(format!(
-                "table at {table_offset} and data at {data_offset} where v1 puts them at {HEADER_BYTES} and {table_end}"
+                "table at {table_offset} and data at {data_offset} where v{version} puts them at {header_len} and {table_end}"
             )));
         }
         let declared = get_u64(b, 104);
@@ -388,7 +494,18 @@ impl Header {
         let name_bytes = &b[224..224 + NAME_BYTES];
         let name_len = name_bytes.iter().position(|&c| c == 0).unwrap_or(NAME_BYTES);
         let source_name = String::from_utf8_lossy(&name_bytes[..name_len]).into_owned();
+        let (source_width, source_height) = (get_u32(b, 144), get_u32(b, 148));
+        if let Some(src) = &source {
+            if (src.width, src.height, src.wraps) != (source_width, source_height, b[152] != 0) {
+                return Err(corrupt(format!(
+                    "the source block gives a grid of {} x {} samples, the header {source_width} x {source_height}",
+                    src.width, src.height
+                )));
+            }
+        }
         Ok(Header {
+            version,
+            source,
             n,
             levels,
             format,
@@ -403,13 +520,59 @@ impl Header {
             data_offset,
             file_len,
             extent,
-            source_width: get_u32(b, 144),
-            source_height: get_u32(b, 148),
+            source_width,
+            source_height,
             source_wraps: b[152] != 0,
             digest,
             source_name,
         })
     }
+}
+
+/// Decodes and checks the source block (bytes 512..640) of a version 2 header.
+fn decode_source_block(b: &[u8], corrupt: &dyn Fn(String) -> DemError) -> Result<SourceLayout, DemError> {
+    let crc = crc32fast::hash(&b[512..636]);
+    if crc != get_u32(b, 636) {
+        return Err(corrupt(format!(
+            "the source block's checksum is {:08x} but its bytes give {crc:08x}",
+            get_u32(b, 636)
+        )));
+    }
+    let src = SourceLayout {
+        lon_first: get_f64(b, 512),
+        lon_step: get_f64(b, 520),
+        lat_first: get_f64(b, 528),
+        lat_step: get_f64(b, 536),
+        width: get_u32(b, 544),
+        height: get_u32(b, 548),
+        tile: get_u32(b, 552),
+        wraps: b[556] != 0,
+    };
+    let axes_ok = src.lon_first.is_finite()
+        && src.lat_first.is_finite()
+        && src.lon_step.is_finite()
+        && src.lon_step > 0.0
+        && src.lat_step.is_finite()
+        && src.lat_step > 0.0;
+    if !axes_ok {
+        return Err(corrupt(format!(
+            "source axes from {} by {} degrees of longitude and from {} by {} of latitude",
+            src.lon_first, src.lon_step, src.lat_first, src.lat_step
+        )));
+    }
+    if src.width < 2 || src.height < 2 {
+        return Err(corrupt(format!(
+            "a source grid of {} x {} samples (at least 2 x 2 are valid)",
+            src.width, src.height
+        )));
+    }
+    if !(2..=4096).contains(&src.tile) {
+        return Err(corrupt(format!("source tile size {} (2 to 4096 are valid)", src.tile)));
+    }
+    if src.total() > super::import::MAX_TILES {
+        return Err(corrupt(format!("{} source tiles", src.total())));
+    }
+    Ok(src)
 }
 
 /// How a tile's samples are stored.
@@ -439,12 +602,12 @@ impl Entry {
         out.extend_from_slice(&[0u8; 7]);
     }
 
-    /// Decodes entry `idx` and checks it against the tile's geometry and the data area.
+    /// Decodes entry `idx` of a tile of `samples` samples and checks it against the data area.
     pub fn decode(
         file: &str,
         b: &[u8],
         idx: u64,
-        tile: &TileRef,
+        samples: usize,
         format: SampleFormat,
         data: (u64, u64),
     ) -> Result<Entry, DemError> {
@@ -462,7 +625,7 @@ impl Entry {
             }
         };
         let expected = match kind {
-            TileKind::Raw => tile.w as usize * tile.h as usize * format.bytes(),
+            TileKind::Raw => samples * format.bytes(),
             TileKind::Constant => format.bytes(),
         };
         let end = offset.checked_add(u64::from(len));

@@ -2,8 +2,8 @@
 //! `.pmcdem` file with bounded memory.
 
 use super::format::{
-    stored_levels, Entry, Header, SampleFormat, TileGrid, TileKind, TileRef, DEFAULT_TILE_SIZE, ENTRY_BYTES,
-    HEADER_BYTES, MAX_DATA_LEVEL,
+    stored_levels, Entry, Header, SampleFormat, SourceLayout, TileGrid, TileKind, TileRef, DEFAULT_SOURCE_TILE_SIZE,
+    DEFAULT_TILE_SIZE, ENTRY_BYTES, HEADER_BYTES_V2, MAX_DATA_LEVEL, VERSION,
 };
 use super::lattice::lattice_of;
 use super::source_grid::{CoarseFill, GridPos, SourceGrid};
@@ -90,6 +90,12 @@ pub struct ImportReport {
     pub samples: u64,
     /// Samples of the finest level whose value was filled (missing in the source).
     pub filled: u64,
+    /// Source samples stored (the source grid kept in the file, `width x height`).
+    pub source_samples: u64,
+    /// Source samples whose value was missing and filled.
+    pub source_filled: u64,
+    /// Bytes of the stored source grid: its tiles and their table entries.
+    pub source_bytes: u64,
     /// Tiles written.
     pub tiles: u64,
     /// Tiles stored as one constant.
@@ -150,8 +156,9 @@ fn invalid(source: &dyn EquirectSource, detail: String) -> DemError {
     }
 }
 
-/// Reprojects `source` onto the six faces of the cube and writes a `.pmcdem` file at `out`
-/// (format: `docs/specs/pmcdem-v1.md`).
+/// Reprojects `source` onto the six faces of the cube and writes a `.pmcdem` version 2 file at
+/// `out` (format: `docs/specs/pmcdem-v2.md`) that also keeps the source grid itself, from which
+/// [`CubeDem`](crate::CubeDem) takes its heights (exact at every source sample).
 ///
 /// Each sample of each face is the lattice point `N n + (2i - N) u + (2j - N) v` of resolution
 /// `N = 2^n`, mapped to the sphere by `cube_to_sphere`; its latitude and longitude are
@@ -161,11 +168,13 @@ fn invalid(source: &dyn EquirectSource, detail: String) -> DemError {
 /// equal the finest samples at the same point. Missing samples (NaN, or outside a regional grid)
 /// take [`ImportOptions::fill_value`] or the nearest valid coarse value, and are counted.
 ///
-/// Memory: the source is read twice in bands of rows (a pre-pass for the range, the sample
-/// format and the fill, then the reprojection), never more than half of
-/// [`ImportOptions::memory_budget`] bytes of rows at once; tiles are written as soon as they
-/// are complete. Work is spread over rayon's threads. `progress(done, total)` is called as tiles
-/// are written.
+/// Memory: the source is read three times in bands of rows (a pre-pass for the range, the
+/// sample format and the fill, the reprojection, then the source grid's own tiles), never more
+/// than half of [`ImportOptions::memory_budget`] bytes of rows at once from the source; the last
+/// pass also holds one row of source tiles
+/// ([`DEFAULT_SOURCE_TILE_SIZE`](crate::cube::DEFAULT_SOURCE_TILE_SIZE) rows). Tiles are written
+/// as soon as they are complete. Work is spread over rayon's threads. `progress(done, total)` is
+/// called as face tiles are written.
 ///
 /// The file is written to a temporary file next to `out` and renamed into place only on
 /// success: on any error nothing is left at `out` (an existing file there is left as it was).
@@ -283,7 +292,30 @@ pub fn import_cube(
     };
     let file = tmp.file.as_ref().expect("just created");
 
-    let data_offset = (HEADER_BYTES + tiles.total as usize * ENTRY_BYTES + 4) as u64;
+    if u32::try_from(w).is_err() || u32::try_from(h).is_err() {
+        return Err(invalid(
+            source,
+            format!("a grid of {w} x {h} samples; at most 2^32 - 1 a side are supported"),
+        ));
+    }
+    let src_layout = SourceLayout {
+        lon_first: source.lon_first(),
+        lon_step: source.lon_step(),
+        lat_first: source.lat_first(),
+        lat_step: source.lat_step(),
+        width: w as u32,
+        height: h as u32,
+        tile: DEFAULT_SOURCE_TILE_SIZE,
+        wraps: grid.wraps,
+    };
+    let all_tiles = tiles.total + src_layout.total();
+    if all_tiles > MAX_TILES {
+        return Err(invalid(
+            source,
+            format!("the faces and the source grid make {all_tiles} tiles, more than the {MAX_TILES} supported; use larger tiles or a larger memory budget"),
+        ));
+    }
+    let data_offset = (HEADER_BYTES_V2 + all_tiles as usize * ENTRY_BYTES + 4) as u64;
     let mut write_at = data_offset;
     let mut entries: Vec<Entry> = vec![
         Entry {
@@ -292,9 +324,9 @@ pub fn import_cube(
             crc: 0,
             kind: TileKind::Raw
         };
-        tiles.total as usize
+        all_tiles as usize
     ];
-    let mut hashes: Vec<[u8; 32]> = vec![[0; 32]; tiles.total as usize];
+    let mut hashes: Vec<[u8; 32]> = vec![[0; 32]; all_tiles as usize];
     let filled = AtomicU64::new(0);
     let mut constant_tiles = 0u64;
     let mut done = 0u64;
@@ -386,7 +418,66 @@ pub fn import_cube(
     }
     debug_assert!(open.is_empty());
 
-    let digest = content_digest(n, format, &hashes);
+    // The source grid itself, a row of tiles at a time (read in bands of at most `max_rows`
+    // rows), missing values filled.
+    let mut source_filled = 0u64;
+    let mut source_bytes = 0u64;
+    let th = src_layout.tile as usize;
+    let mut tile_rows = vec![0f32; th.min(h) * w];
+    for ty in 0..src_layout.tiles_y() {
+        let r0 = ty as usize * th;
+        let rows = th.min(h - r0);
+        let buf = &mut tile_rows[..rows * w];
+        let mut done_rows = 0;
+        while done_rows < rows {
+            let n = max_rows.min(rows - done_rows);
+            let b = &mut band[..n * w];
+            source.read_rows(r0 + done_rows, n, b)?;
+            buf[done_rows * w..(done_rows + n) * w].copy_from_slice(b);
+            done_rows += n;
+        }
+        for (k, v) in buf.iter_mut().enumerate() {
+            if !v.is_finite() {
+                source_filled += 1;
+                let pos = GridPos {
+                    x: (k % w) as f64,
+                    y: (r0 + k / w) as f64,
+                    inside: true,
+                };
+                *v = options.fill_value.unwrap_or_else(|| survey.fill.value(&pos));
+            }
+        }
+        let buf = &tile_rows[..rows * w];
+        let first = u64::from(ty) * u64::from(src_layout.tiles_x());
+        let encoded: Vec<(u64, TileKind, Vec<u8>, [u8; 32])> = (first..first + u64::from(src_layout.tiles_x()))
+            .into_par_iter()
+            .map(|k| {
+                let t = src_layout.tile_ref(k);
+                let mut vals = Vec::with_capacity(t.w as usize * t.h as usize);
+                for r in 0..t.h as usize {
+                    let at = r * w + t.c0 as usize;
+                    vals.extend_from_slice(&buf[at..at + t.w as usize]);
+                }
+                let (kind, bytes) = encode_tile(format, &vals);
+                let hash = tile_hash(kind, &bytes);
+                (tiles.total + k, kind, bytes, hash)
+            })
+            .collect();
+        for (idx, kind, bytes, hash) in encoded {
+            file.write_all_at(&bytes, write_at).map_err(werr)?;
+            entries[idx as usize] = Entry {
+                offset: write_at,
+                len: bytes.len() as u32,
+                crc: crc32fast::hash(&bytes),
+                kind,
+            };
+            hashes[idx as usize] = hash;
+            write_at += bytes.len() as u64;
+            source_bytes += (bytes.len() + ENTRY_BYTES) as u64;
+        }
+    }
+
+    let digest = content_digest(n, format, &hashes, Some(&src_layout));
     let mut table = Vec::with_capacity(entries.len() * ENTRY_BYTES + 4);
     for e in &entries {
         e.encode(&mut table);
@@ -395,6 +486,8 @@ pub fn import_cube(
     table.extend_from_slice(&crc.to_le_bytes());
     let (min, max) = value_range(format, &survey, options.fill_value);
     let header = Header {
+        version: VERSION,
+        source: Some(src_layout),
         n,
         levels: stored_levels(n),
         format,
@@ -405,7 +498,7 @@ pub fn import_cube(
         max,
         filled: filled.load(Ordering::Relaxed),
         tiles: tiles.total,
-        table_offset: HEADER_BYTES as u64,
+        table_offset: HEADER_BYTES_V2 as u64,
         data_offset,
         file_len: write_at,
         extent: grid.extent(),
@@ -415,7 +508,7 @@ pub fn import_cube(
         digest: digest.clone(),
         source_name: source.name().to_owned(),
     };
-    file.write_all_at(&table, HEADER_BYTES as u64).map_err(werr)?;
+    file.write_all_at(&table, HEADER_BYTES_V2 as u64).map_err(werr)?;
     file.write_all_at(&header.encode(), 0).map_err(werr)?;
     let mut f = tmp.file.take().expect("open");
     f.flush().map_err(werr)?;
@@ -431,6 +524,9 @@ pub fn import_cube(
         format,
         samples,
         filled: header.filled,
+        source_samples: w as u64 * h as u64,
+        source_filled,
+        source_bytes,
         tiles: tiles.total,
         constant_tiles,
         bytes: write_at,
@@ -572,11 +668,18 @@ pub(crate) fn tile_hash(kind: TileKind, bytes: &[u8]) -> [u8; 32] {
     h.finalize().into()
 }
 
-/// The content digest: SHA-256 of `"pmcdem-v1"`, the data level, the format code, scale and
-/// offset, and the tile hashes in table order; as 64 lower-case hex digits.
-pub(crate) fn content_digest(n: u32, format: SampleFormat, hashes: &[[u8; 32]]) -> String {
+/// The content digest: SHA-256 of `"pmcdem-v1"` (version 1) or `"pmcdem-v2"` (version 2), the
+/// data level, the format code, scale and offset, in version 2 the source block's geometry
+/// bytes, and the tile hashes in table order (version 2: the face tiles, then the source tiles);
+/// as 64 lower-case hex digits.
+pub(crate) fn content_digest(
+    n: u32,
+    format: SampleFormat,
+    hashes: &[[u8; 32]],
+    source: Option<&SourceLayout>,
+) -> String {
     let mut h = Sha256::new();
-    h.update(b"pmcdem-v1");
+    h.update(if source.is_some() { b"pmcdem-v2" } else { b"pmcdem-v1" });
     h.update([n as u8, format.code()]);
     let (scale, offset) = match format {
         SampleFormat::I16 { scale, offset } => (scale, offset),
@@ -584,6 +687,9 @@ pub(crate) fn content_digest(n: u32, format: SampleFormat, hashes: &[[u8; 32]]) 
     };
     h.update(scale.to_le_bytes());
     h.update(offset.to_le_bytes());
+    if let Some(src) = source {
+        h.update(src.geometry_bytes());
+    }
     for t in hashes {
         h.update(t);
     }

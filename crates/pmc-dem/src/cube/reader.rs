@@ -1,8 +1,9 @@
 //! Reading `.pmcdem` files tile by tile, with checksums and a bounded cache of decoded tiles.
 
 use super::detail::DetailNoise;
-use super::format::{Entry, Header, SampleFormat, TileGrid, TileKind, ENTRY_BYTES, HEADER_BYTES};
+use super::format::{Entry, Header, SampleFormat, TileGrid, TileKind, ENTRY_BYTES, HEADER_BYTES_V2};
 use super::import::{centre_spacing_radians, content_digest, tile_hash};
+use super::source_grid::SourceGrid;
 use crate::error::DemError;
 use pmc_geometry::Face;
 use std::collections::{HashMap, VecDeque};
@@ -16,11 +17,16 @@ pub const DEFAULT_CACHE_BYTES: usize = 256 << 20;
 /// Lock shards of the tile cache (tiles are spread over them by index).
 const SHARDS: usize = 16;
 
-/// A cube-face elevation model read from a `.pmcdem` file (`docs/specs/pmcdem-v1.md`).
+/// A cube-face elevation model read from a `.pmcdem` file (`docs/specs/pmcdem-v2.md`; version 1
+/// files, `docs/specs/pmcdem-v1.md`, are read too).
 ///
 /// [`CubeDem::open`] reads and checks the header and the tile table only; tiles are read when
 /// first needed, with positioned reads, their checksums checked, and kept decoded in a cache of
 /// bounded size (first in, first out). `Send + Sync`: one `CubeDem` serves many threads.
+///
+/// Heights: a version 2 file keeps the source grid, and heights are interpolated from it
+/// directly (exact at every source sample); a version 1 file has only the cube faces, and heights
+/// are interpolated from the face samples (exact at the face samples).
 #[derive(Debug)]
 pub struct CubeDem {
     pub(crate) path: String,
@@ -31,6 +37,10 @@ pub struct CubeDem {
     shards: Vec<Mutex<Shard>>,
     shard_budget: usize,
     spacing: f64,
+    /// Version 2: the source grid's axes (where a place falls on it).
+    pub(crate) source_grid: Option<SourceGrid>,
+    /// Version 2: metres between the source's rows (the spacing of its relief weights).
+    pub(crate) source_spacing: f64,
 }
 
 #[derive(Debug, Default)]
@@ -81,10 +91,11 @@ impl CubeDem {
         };
         let file = File::open(path.as_ref()).map_err(io)?;
         let len = file.metadata().map_err(io)?.len();
-        let mut head = vec![0u8; (HEADER_BYTES as u64).min(len) as usize];
+        let mut head = vec![0u8; (HEADER_BYTES_V2 as u64).min(len) as usize];
         file.read_exact_at(&mut head, 0).map_err(io)?;
         let header = Header::decode(&name, &head, len)?;
         let grid = TileGrid::new(header.n, header.tile);
+        let source = header.source;
         let mut table = vec![0u8; (header.data_offset - header.table_offset) as usize];
         file.read_exact_at(&mut table, header.table_offset).map_err(io)?;
         let (body, crc) = table.split_at(table.len() - 4);
@@ -99,12 +110,33 @@ impl CubeDem {
             .chunks_exact(ENTRY_BYTES)
             .enumerate()
             .map(|(k, b)| {
-                let t = grid.tile(k as u64);
-                Entry::decode(&name, b, k as u64, &t, header.format, (header.data_offset, len))
+                let k = k as u64;
+                let samples = match (k.checked_sub(grid.total), &source) {
+                    (Some(s), Some(src)) => {
+                        let t = src.tile_ref(s);
+                        t.w as usize * t.h as usize
+                    }
+                    _ => {
+                        let t = grid.tile(k);
+                        t.w as usize * t.h as usize
+                    }
+                };
+                Entry::decode(&name, b, k, samples, header.format, (header.data_offset, len))
             })
             .collect::<Result<Vec<_>, _>>()?;
         let spacing = centre_spacing_radians(header.n) * header.radius;
+        let source_grid = source.map(|s| {
+            SourceGrid::from_axes(
+                s.width as usize,
+                s.height as usize,
+                [s.lon_first, s.lon_step, s.lat_first, s.lat_step],
+                s.wraps,
+            )
+        });
+        let source_spacing = source.map_or(f64::NAN, |s| s.lat_step.to_radians() * header.radius);
         Ok(CubeDem {
+            source_grid,
+            source_spacing,
             spacing,
             path: name,
             file,
@@ -114,6 +146,63 @@ impl CubeDem {
             shards: (0..SHARDS).map(|_| Mutex::new(Shard::default())).collect(),
             shard_budget: cache_bytes / SHARDS,
         })
+    }
+
+    /// The format version of the file: 1 (cube faces only) or 2 (cube faces and the source grid,
+    /// from which heights are taken).
+    pub fn version(&self) -> u32 {
+        self.header.version
+    }
+    /// Whether the file keeps the source grid (version 2), so that heights are exact at every
+    /// source sample.
+    pub fn keeps_source(&self) -> bool {
+        self.header.source.is_some()
+    }
+    /// Columns and rows of the stored source grid (version 2), `None` in a version 1 file.
+    pub fn source_size(&self) -> Option<(u32, u32)> {
+        self.header.source.map(|s| (s.width, s.height))
+    }
+    /// Bytes the stored source grid takes in the file (its tiles and their table entries); 0 in
+    /// a version 1 file.
+    pub fn source_bytes(&self) -> u64 {
+        self.entries[self.grid.total as usize..]
+            .iter()
+            .map(|e| u64::from(e.len) + ENTRY_BYTES as u64)
+            .sum()
+    }
+    /// The stored value of source sample `(column, row)` (rows from south to north, columns from
+    /// west to east, missing values filled at import). Errors: a version 1 file or indices
+    /// outside the grid ([`DemError::OutOfGrid`]), or a tile that cannot be read.
+    pub fn source_sample(&self, column: u32, row: u32) -> Result<f32, DemError> {
+        match self.header.source {
+            Some(s) if column < s.width && row < s.height => self.source_value(column, row),
+            _ => Err(DemError::OutOfGrid {
+                file: self.path.clone(),
+                detail: format!(
+                    "source sample ({column}, {row}) asked for; the file keeps {}",
+                    self.header
+                        .source
+                        .map_or("no source grid (version 1)".to_owned(), |s| format!(
+                            "a source grid of {} x {}",
+                            s.width, s.height
+                        ))
+                ),
+            }),
+        }
+    }
+
+    /// The value of an in-range source sample of a version 2 file.
+    #[inline]
+    pub(crate) fn source_value(&self, c: u32, r: u32) -> Result<f32, DemError> {
+        let src = self.header.source.as_ref().expect("a version 2 file");
+        let k = src.index_of(c, r);
+        let tile = self.tile(self.grid.total + k)?;
+        if tile.len() == 1 {
+            return Ok(tile[0]);
+        }
+        let t = src.tile;
+        let w = src.width.min((c / t) * t + t) - (c / t) * t;
+        Ok(tile[((r % t) * w + (c % t)) as usize])
     }
 
     /// The path the file was opened from.
@@ -195,7 +284,7 @@ impl CubeDem {
     pub fn storage_table(&self) -> Vec<StorageRow> {
         let r = self.header.radius;
         let mut stored_bytes = vec![0u64; self.grid.levels.len()];
-        for (k, e) in self.entries.iter().enumerate() {
+        for (k, e) in self.entries[..self.grid.total as usize].iter().enumerate() {
             let level = self.grid.tile(k as u64).level as usize;
             stored_bytes[level] += u64::from(e.len) + ENTRY_BYTES as u64;
         }
@@ -265,16 +354,28 @@ impl CubeDem {
                 source,
             })?;
         if crc32fast::hash(&bytes) != e.crc {
-            let t = self.grid.tile(idx);
+            let detail = match (idx.checked_sub(self.grid.total), &self.header.source) {
+                (Some(k), Some(src)) => {
+                    let t = src.tile_ref(k);
+                    format!(
+                        "tile {idx} (source grid, columns from {}, rows from {}) fails its checksum",
+                        t.c0, t.r0
+                    )
+                }
+                _ => {
+                    let t = self.grid.tile(idx);
+                    format!(
+                        "tile {idx} (level {}, face {}, tile column {}, row {}) fails its checksum",
+                        t.level,
+                        Face::ALL[t.face],
+                        t.ti,
+                        t.tj
+                    )
+                }
+            };
             return Err(DemError::CubeCorrupt {
                 file: self.path.clone(),
-                detail: format!(
-                    "tile {idx} (level {}, face {}, tile column {}, row {}) fails its checksum",
-                    t.level,
-                    Face::ALL[t.face],
-                    t.ti,
-                    t.tj
-                ),
+                detail,
             });
         }
         Ok((e, bytes))
@@ -311,11 +412,11 @@ impl CubeDem {
     /// the header's. Streams the file tile by tile (the cache is not used).
     pub fn verify(&self) -> Result<(), DemError> {
         let mut hashes = Vec::with_capacity(self.entries.len());
-        for idx in 0..self.grid.total {
+        for idx in 0..self.entries.len() as u64 {
             let (e, bytes) = self.read_tile_bytes(idx)?;
             hashes.push(tile_hash(e.kind, &bytes));
         }
-        let digest = content_digest(self.header.n, self.header.format, &hashes);
+        let digest = content_digest(self.header.n, self.header.format, &hashes, self.header.source.as_ref());
         if digest != self.header.digest {
             return Err(DemError::CubeCorrupt {
                 file: self.path.clone(),

@@ -1,4 +1,6 @@
-//! Heights anywhere on the sphere: interpolated data plus detail noise, exact at data samples.
+//! Heights anywhere on the sphere: interpolated data plus detail noise. Version 2 files take the
+//! data from the source grid (`source_sample.rs`), exact at every source sample; version 1 files
+//! from the face samples (this file), exact at every face sample.
 
 use super::detail::{DetailNoise, MAX_DETAIL_OCTAVES};
 use super::lattice::{home_face, indices_on, unfold};
@@ -10,7 +12,7 @@ pub use pmc_density::terrain::Interpolation;
 
 /// The relief weight at `(fs, ft)` in a cell from its corners' weights, bilinearly.
 #[inline]
-fn lerp_reliefs(r: &[f64; 4], fs: f64, ft: f64) -> f64 {
+pub(crate) fn lerp_reliefs(r: &[f64; 4], fs: f64, ft: f64) -> f64 {
     let (a, bb, c, d) = (r[0], r[1], r[2], r[3]);
     let lo = a + fs * (bb - a);
     let hi = c + fs * (d - c);
@@ -22,7 +24,7 @@ pub const MAX_LATTICE_RESOLUTION: i32 = 1 << 30;
 
 /// Catmull-Rom weights at `t` in `[0, 1]`: exactly `(0, 1, 0, 0)` at 0 and `(0, 0, 1, 0)` at 1.
 #[inline]
-fn catmull_rom(t: f64) -> [f64; 4] {
+pub(crate) fn catmull_rom(t: f64) -> [f64; 4] {
     let t2 = t * t;
     let t3 = t2 * t;
     [
@@ -200,7 +202,14 @@ impl CubeDem {
 
     /// Interpolated data at fractional sample indices `(s, t)` of `face`, and the relief weight
     /// of the detail there (1 when the detail is off).
-    fn interpolate(&self, face: Face, s: f64, t: f64, interp: Interpolation, detail: &DetailNoise) -> (f64, f64) {
+    pub(crate) fn interpolate(
+        &self,
+        face: Face,
+        s: f64,
+        t: f64,
+        interp: Interpolation,
+        detail: &DetailNoise,
+    ) -> (f64, f64) {
         let Some((i0, j0, fs, ft)) = self.cell(s, t) else {
             return (f64::NAN, f64::NAN);
         };
@@ -267,6 +276,11 @@ impl CubeDem {
     /// lattice point `lattice` of resolution `m` (a power of two; coordinates in `[-m, m]`, on
     /// the cube surface: one coordinate `= ±m`, all of the parity of `m`).
     ///
+    /// In a version 2 file the height is the source grid interpolated at the point's direction
+    /// `cube_to_sphere(lattice / m)` (exact at every source sample), plus the detail octaves
+    /// `0 .. log2(m) - n` (none when `m <= 2^n`) faded to zero at the source samples: a function
+    /// of the place alone, the same bits for `(2 lattice, 2m)`. In a version 1 file:
+    ///
     /// When `m <= 2^n` the point is a data sample: its stored value is returned exactly (read
     /// from the stored level of resolution `m`, or the coarsest overview when `m` is coarser;
     /// all levels hold the same bits), with no noise. When `m > 2^n` the point lies between
@@ -287,6 +301,9 @@ impl CubeDem {
         let Some(face) = home_face(lattice, m) else {
             return f64::NAN;
         };
+        if self.source_grid.is_some() {
+            return self.source_height_at_lattice(lattice, m, interp, detail);
+        }
         let n = self.header.n;
         let big_n = 1i32 << n;
         if m <= big_n {
@@ -329,6 +346,9 @@ impl CubeDem {
         out: &mut [f64],
     ) {
         assert_eq!(points.len(), out.len(), "one output per point");
+        if self.source_grid.is_some() {
+            return self.source_heights_at_lattice(points, m, interp, detail, out);
+        }
         let n = self.header.n;
         let big_n = 1i32 << n;
         let fine = m > big_n && m <= MAX_LATTICE_RESOLUTION && m.count_ones() == 1;
@@ -416,9 +436,11 @@ impl CubeDem {
     /// [`CubeDem::heights_at_lattice`] of the entries of a face grid (`points[b * side + a]` is
     /// the lattice point of the entry's face indices wherever one exists), with the same bits.
     ///
-    /// The entries strictly inside the face share their column's sample cell, fraction and
-    /// bicubic weights along `u` and their row's along `v`, computed once; the others (on or past
-    /// the face's edges, where several faces meet) go through [`CubeDem::heights_at_lattice`].
+    /// Version 1: the entries strictly inside the face share their column's sample cell,
+    /// fraction and bicubic weights along `u` and their row's along `v`, computed once; the
+    /// others (on or past the face's edges, where several faces meet) go through
+    /// [`CubeDem::heights_at_lattice`]. Version 2: [`CubeDem::heights_at_lattice`] of all of them
+    /// (a point's place on the source grid depends on both of its indices).
     ///
     /// Panics when `points`, `out` and the grid differ in length (a caller's bug).
     #[allow(clippy::too_many_arguments)]
@@ -435,6 +457,9 @@ impl CubeDem {
             points.len() == out.len() && points.len() == grid.len(),
             "one point and one output per grid entry"
         );
+        if self.source_grid.is_some() {
+            return self.source_heights_at_lattice(points, m, interp, detail, out);
+        }
         let n = self.header.n;
         let big_n = 1i32 << n;
         let fine = m > big_n && m <= MAX_LATTICE_RESOLUTION && m.count_ones() == 1;
@@ -537,6 +562,14 @@ impl CubeDem {
         if finest_spacing_m.is_nan() {
             return f64::NAN;
         }
+        let spacing = self.data_spacing();
+        let mut octaves = 0;
+        while octaves < MAX_DETAIL_OCTAVES && spacing / f64::from(1u32 << octaves) >= finest_spacing_m {
+            octaves += 1;
+        }
+        if self.source_grid.is_some() {
+            return self.source_height(dir, interp, detail, octaves);
+        }
         let Some((face, u, v)) = sphere_to_face_uv(dir) else {
             return f64::NAN;
         };
@@ -544,11 +577,6 @@ impl CubeDem {
         let (value, weight) = self.interpolate(face, (u + 1.0) * half, (v + 1.0) * half, interp, detail);
         if !detail.is_on() {
             return value;
-        }
-        let spacing = self.data_spacing();
-        let mut octaves = 0;
-        while octaves < MAX_DETAIL_OCTAVES && spacing / f64::from(1u32 << octaves) >= finest_spacing_m {
-            octaves += 1;
         }
         value + weight * detail.sum(face_uv_to_cube(face, u, v) * half, octaves, spacing)
     }

@@ -32,22 +32,40 @@ pub(crate) struct GridPos {
 
 impl SourceGrid {
     pub fn new(s: &dyn EquirectSource) -> SourceGrid {
-        let (w, h) = (s.width(), s.height());
-        let lat_last = s.lat_first() + (h.saturating_sub(1)) as f64 * s.lat_step();
-        let wraps = s.wraps_in_longitude();
+        SourceGrid::from_axes(
+            s.width(),
+            s.height(),
+            [s.lon_first(), s.lon_step(), s.lat_first(), s.lat_step()],
+            s.wraps_in_longitude(),
+        )
+    }
+
+    /// The grid of `w x h` samples with axes `[lon_first, lon_step, lat_first, lat_step]`
+    /// (degrees), wrapping in longitude or not.
+    pub fn from_axes(w: usize, h: usize, axes: [f64; 4], wraps: bool) -> SourceGrid {
+        let [lon_first, lon_step, lat_first, lat_step] = axes;
+        let lat_last = lat_first + (h.saturating_sub(1)) as f64 * lat_step;
         SourceGrid {
             w,
             h,
-            lon_first: s.lon_first(),
-            lon_step: s.lon_step(),
-            lat_first: s.lat_first(),
-            lat_step: s.lat_step(),
+            lon_first,
+            lon_step,
+            lat_first,
+            lat_step,
             wraps,
             // A global grid whose first (last) row lies within one step of the pole: the cap
             // beyond it takes the row's values. Otherwise the cap is outside the data.
-            clamp_south: wraps && s.lat_first() - s.lat_step() <= -90.0 + 1e-9,
-            clamp_north: wraps && lat_last + s.lat_step() >= 90.0 - 1e-9,
+            clamp_south: wraps && lat_first - lat_step <= -90.0 + 1e-9,
+            clamp_north: wraps && lat_last + lat_step >= 90.0 - 1e-9,
         }
+    }
+
+    /// The latitude and longitude (degrees) of sample `(c, r)`.
+    pub fn lat_lon(&self, c: usize, r: usize) -> (f64, f64) {
+        (
+            self.lat_first + r as f64 * self.lat_step,
+            self.lon_first + c as f64 * self.lon_step,
+        )
     }
 
     /// West, east, south and north bounds of the samples, in degrees.
@@ -58,6 +76,22 @@ impl SourceGrid {
             self.lat_first,
             self.lat_first + (self.h - 1) as f64 * self.lat_step,
         ]
+    }
+
+    /// The latitude and longitude (degrees) of direction `p` (any length), as
+    /// `LatLon::from_point` gives them but for rounding (`sqrt` in place of `hypot`, which is
+    /// several times slower and guards only against overflow, impossible for a direction on the
+    /// unit sphere or the cube); `None` for the origin or non-finite input. At the poles the
+    /// longitude is 0.
+    #[inline]
+    pub fn lat_lon_of(p: pmc_geometry::glam::DVec3) -> Option<(f64, f64)> {
+        if !p.is_finite() || p == pmc_geometry::glam::DVec3::ZERO {
+            return None;
+        }
+        let h = (p.x * p.x + p.z * p.z).sqrt();
+        let lat = p.y.atan2(h).to_degrees();
+        let lon = if h == 0.0 { 0.0 } else { p.x.atan2(p.z).to_degrees() };
+        Some((lat, lon))
     }
 
     /// The grid position of a latitude and longitude (degrees).
@@ -94,6 +128,29 @@ impl SourceGrid {
             }
         }
         GridPos { x, y, inside }
+    }
+
+    /// How far a latitude and longitude (degrees) lie outside the grid's extent, in cells (the
+    /// larger of the overshoots in rows and columns); 0 inside, and in the polar caps that a
+    /// global grid clamps.
+    pub fn outside_cells(&self, lat: f64, lon: f64) -> f64 {
+        let hmax = (self.h - 1) as f64;
+        let y = (lat - self.lat_first) / self.lat_step;
+        let mut over = 0.0f64;
+        if y < 0.0 && !self.clamp_south {
+            over = -y;
+        } else if y > hmax && !self.clamp_north {
+            over = y - hmax;
+        }
+        if !self.wraps {
+            let wmax = (self.w - 1) as f64;
+            let d = (lon - self.lon_first).rem_euclid(360.0);
+            let x = d / self.lon_step;
+            if x > wmax {
+                over = over.max((x - wmax).min((360.0 - d) / self.lon_step));
+            }
+        }
+        over
     }
 
     /// The lower of the two rows a position interpolates between (`0 ..= h - 2`).
