@@ -5,6 +5,7 @@
 #   ./scripts/run.sh --preset mars --seed 3 --port 9000
 #   ./scripts/run.sh --world my.pmcw
 #   ./scripts/run.sh --dem earth.pmcdem    (a real planet: see pmc dem import)
+#   ./scripts/run.sh --dem earth.pmcdem --imagery earth.pmcimg   (coloured: see pmc imagery import)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

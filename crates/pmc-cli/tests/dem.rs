@@ -249,7 +249,16 @@ fn an_extent_west_of_greenwich_is_read_as_the_extent() {
     let out = d.join("west.pmcdem");
     let png = fixture("etopo5deg.png");
     ok(&[
-        "dem", "import", &png, "-o", s(&out), "--extent", "-10,-5,10,5", "--level", "4", "--quiet",
+        "dem",
+        "import",
+        &png,
+        "-o",
+        s(&out),
+        "--extent",
+        "-10,-5,10,5",
+        "--level",
+        "4",
+        "--quiet",
     ]);
     let (info, _) = ok(&["dem", "info", s(&out), "--json"]);
     let v: serde_json::Value = serde_json::from_str(&info).unwrap();

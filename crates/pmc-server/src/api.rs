@@ -91,6 +91,7 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
         "faces": faces,
         "materials": t.materials,
         "palette": { "a": t.blend_colors[0], "b": t.blend_colors[1] },
+        "imagery": crate::imagery_api::planet_field(&state, *id == state.config().terrain),
         "edit": crate::edit_api::edit_info(&state, id),
     });
     Ok(json_response(v, "no-cache"))
@@ -228,7 +229,7 @@ pub async fn stats(State(state): State<AppState>) -> Response {
 pub async fn not_found(uri: Uri) -> ApiError {
     ApiError::not_found(format!(
         "no such API endpoint: {}; see docs/specs/http-api-v1.md (GET /api/v1/health, /planet, /chunks, \
-         /chunk/FACE/LEVEL/I/J/K, /stats, /edits, /events, /path, /navgrid; POST /api/v1/edits, /edits/undo, \
+         /chunk/FACE/LEVEL/I/J/K, /stats, /imagery, /edits, /events, /path, /navgrid; POST /api/v1/edits, /edits/undo, \
          /edits/redo)",
         uri.path()
     ))

@@ -67,6 +67,10 @@ pub struct ServerConfig {
     /// How the default planet is meshed: marching cubes (caves, overhangs, editing) or, for an
     /// elevation model, a height field of 65 x 65 patches (seed 003).
     pub mesher: Mesher,
+    /// A `.pmcimg` imagery file draped on the default planet (`pmc_imagery`), served at
+    /// `/api/v1/imagery` and described in `/api/v1/planet`; read and checked at start. `None`:
+    /// no imagery.
+    pub imagery: Option<PathBuf>,
 }
 
 /// How a server meshes its planet.
@@ -95,6 +99,7 @@ impl Default for ServerConfig {
             edit_limits: EditLimits::default(),
             base_cache_chunks: 256,
             mesher: Mesher::Volumetric,
+            imagery: None,
         }
     }
 }

@@ -47,6 +47,9 @@ pub enum ServerError {
     /// The world file could not be opened or created.
     #[error(transparent)]
     World(#[from] pmc_world::WorldError),
+    /// The imagery file could not be read (missing, damaged, not a `.pmcimg` file).
+    #[error(transparent)]
+    Imagery(#[from] pmc_imagery::ImageryError),
     /// Serving failed after start.
     #[error("the server stopped: {0}")]
     Io(#[from] std::io::Error),

@@ -34,6 +34,7 @@ mod editing;
 mod error;
 pub mod flight;
 mod generator;
+pub mod imagery_api;
 pub mod nav_api;
 mod planets;
 mod rate;

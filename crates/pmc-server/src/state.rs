@@ -21,6 +21,8 @@ struct Inner {
     planets: Planets,
     generator: Arc<Generator>,
     editing: Option<Arc<Editing>>,
+    /// The imagery draped on the default planet, if any.
+    imagery: Option<Arc<crate::imagery_api::ServedImagery>>,
     /// Navigation grids recently used, most recent last.
     navs: std::sync::Mutex<std::collections::VecDeque<NavEntry>>,
     /// Set when the server begins to stop: long-lived answers (the event streams) end.
@@ -129,6 +131,12 @@ impl AppState {
     /// threads. With a world, [`AppState::config`] holds the world's preset, seed and layout.
     pub fn new(mut config: ServerConfig) -> Result<AppState, ServerError> {
         config.validate()?;
+        let imagery = match &config.imagery {
+            Some(path) => Some(Arc::new(crate::imagery_api::ServedImagery::new(
+                pmc_imagery::Imagery::open(path)?,
+            ))),
+            None => None,
+        };
         let editing = match &config.world {
             None => None,
             Some(path) => {
@@ -181,6 +189,7 @@ impl AppState {
                 ),
                 generator: Arc::new(generator),
                 editing,
+                imagery,
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
                 lod_errors: std::sync::Mutex::new(std::collections::HashMap::new()),
                 stopping: tokio::sync::watch::Sender::new(false),
@@ -228,6 +237,11 @@ impl AppState {
                 reused_shading: jobs.reused,
             },
         }
+    }
+
+    /// The imagery draped on the default planet, if the server has one.
+    pub fn imagery(&self) -> Option<&Arc<crate::imagery_api::ServedImagery>> {
+        self.inner.imagery.as_ref()
     }
 
     /// The world being edited, if the server has one.
