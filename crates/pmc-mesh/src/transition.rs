@@ -36,6 +36,14 @@
 //! level-of-detail selection refines such configurations away.
 //!
 //! Patches have no thickness: they fill the crack exactly and add no skirt.
+//!
+//! A place holds one normal: where a coarse edge of the side is cut, the fine vertex on its cut
+//! half (in the same place when the density is linear along the edge) takes the coarse vertex's
+//! normal, inside the side always and on its border lines where [`Transition::share_borders`]
+//! says every chunk of this level around the line does the same. Where the caller cannot tell
+//! (an edge of the coarse neighbour where the chunk beside this one is of its level and may face
+//! nothing coarser: a straight level boundary, or a coarse chunk met only diagonally), the fine
+//! and the coarse copy keep their own levels' normals, and one edge still has one normal.
 
 use crate::mesher::{is_solid, Ctx};
 use pmc_geometry::glam::{DVec2, DVec3};
@@ -50,6 +58,14 @@ pub struct Transition<'a> {
     pub side: ChunkSide,
     /// Gradients at the voxels listed by [`coarse_voxels`] for this side, in that order.
     pub gradients: &'a [DVec3],
+    /// Whether the fine vertices on each of the side's four border lines take the normals of
+    /// the coarse vertices in their places, as the vertices inside the side do: index `[k][e]`
+    /// is the line where the side's in-plane axis `k` (the lower of its two axes first) is at
+    /// its low (`e = 0`) or high (`e = 1`) end. True only where every chunk of this level
+    /// holding the line does the same: where the line runs through the middle of the coarse
+    /// neighbour's side, lies on a cube corner, on the shell's boundary, or on another side of
+    /// this chunk that faces a coarser neighbour.
+    pub share_borders: [[bool; 2]; 2],
 }
 
 /// A padded voxel index `(a, b, c)`.
@@ -142,6 +158,63 @@ impl Ctx<'_> {
                     self.emit_square(&st, q1, q2, flip, &mut coarse_cache);
                 }
             }
+        }
+        for t in transitions {
+            self.share_seam_normals(t, &coarse_cache);
+        }
+    }
+
+    /// Gives each fine vertex on a coarse line of the transition's side (a line of the plane
+    /// through coarse voxels) the normal of the coarse vertex in the same place, on the side's
+    /// border lines only where [`Transition::share_borders`] says so.
+    ///
+    /// Where a coarse edge of the side is cut, exactly one of its two fine halves is cut too,
+    /// and the two cuts are the same place whenever the density is linear along the edge
+    /// (along a column on every height-field terrain, and along a row wherever the terrain is
+    /// locally linear): the patch holds both, the coarse one with the coarse neighbour's
+    /// normal, the fine one with the fine chunk's own. The fine vertex takes the coarse normal
+    /// (its raw gradient, so the two normalise to the same bits), and the place shades the same
+    /// in the fine chunk, in its patch and in the coarse chunk. A vertex inside the side belongs
+    /// to this chunk alone; one on a border line is shared with the other chunks of this level
+    /// around the line, which do the same exactly when the caller's
+    /// [`Transition::share_borders`] holds.
+    fn share_seam_normals(&mut self, t: &Transition, coarse_cache: &HashMap<(usize, usize), u32>) {
+        let (ax, at, inplane) = plane(self.grid, t.side);
+        let m = self.grid.tiles / 2;
+        let g = self.grid;
+        // The voxel at in-plane offset `s` along axis `along` and `c` along the other.
+        let voxel = |along: usize, s: usize, c: usize| {
+            let (x, y) = if along == 0 { (s, c) } else { (c, s) };
+            voxel_at(ax, at, inplane, x, y)
+        };
+        let solid = |v: Voxel| is_solid(self.densities[g.index(v.0, v.1, v.2)]);
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for (along, &axis) in inplane.iter().enumerate() {
+            let across = 1 - along;
+            for q in 0..=m {
+                if (q == 0 && !t.share_borders[across][0]) || (q == m && !t.share_borders[across][1]) {
+                    continue;
+                }
+                let c = 1 + 2 * q;
+                for r in 0..m {
+                    let s = 1 + 2 * r;
+                    let (v0, v1, v2) = (voxel(along, s, c), voxel(along, s + 1, c), voxel(along, s + 2, c));
+                    let (s0, s1, s2) = (solid(v0), solid(v1), solid(v2));
+                    if s0 == s2 {
+                        continue;
+                    }
+                    let Some(&coarse) = coarse_cache.get(&(g.index(v0.0, v0.1, v0.2), axis)) else {
+                        continue;
+                    };
+                    let half = if s0 != s1 { v0 } else { v1 };
+                    if let Some(fine) = self.mesher.cached_vertex(g.index(half.0, half.1, half.2) * 3 + axis) {
+                        pairs.push((fine, coarse));
+                    }
+                }
+            }
+        }
+        for (fine, coarse) in pairs {
+            self.out.normals[fine as usize] = self.out.normals[coarse as usize];
         }
     }
 

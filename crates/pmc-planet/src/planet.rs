@@ -549,7 +549,9 @@ impl Planet {
     ///
     /// The patches' coarse vertices get the coarse neighbour's normals bit for bit: the density
     /// is sampled at the few coarse voxels around the seam (about `3 (n_t / 2 + 3)^2` samples
-    /// per side, not a whole chunk) and differentiated in the neighbour's frame.
+    /// per side, not a whole chunk) and differentiated in the neighbour's frame. A fine vertex
+    /// of the seam in the place of a coarse one takes its normal, so the place shades alike in
+    /// both chunks (see `pmc_mesh::transition` for the lines where the side mask cannot tell).
     ///
     /// # Panics
     /// If `key` is not a chunk of the layout (check with [`Layout::contains_chunk`]).
@@ -626,21 +628,84 @@ impl Planet {
         scratch.densities.resize(grid.sample_count(), 0.0);
         self.sample(key, &grid, &mut scratch.densities, Some(&mut scratch.columns));
         close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
-        let sides: Vec<(ChunkSide, Vec<DVec3>)> = closing
-            .into_iter()
-            .map(|(side, y)| (side, self.coarse_gradients(&grid, side, y)))
+        let sides: Vec<(ChunkSide, Vec<DVec3>, [[bool; 2]; 2])> = closing
+            .iter()
+            .map(|&(side, y)| {
+                let borders = self.shared_seam_borders(&grid, side, &closing);
+                (side, self.coarse_gradients(&grid, side, y), borders)
+            })
             .collect();
         let transitions: Vec<Transition> = sides
             .iter()
-            .map(|(side, g)| Transition {
+            .map(|(side, g, borders)| Transition {
                 side: *side,
                 gradients: g,
+                share_borders: *borders,
             })
             .collect();
         scratch
             .mesher
             .mesh_with_transitions(&grid, &scratch.densities, &transitions, out);
         self.shade_grid(out, &grid, scratch, reuse, false);
+    }
+
+    /// [`Transition::share_borders`] of the chunk of `grid` on `side` (across which the
+    /// neighbour is coarser), `closing` being every side the chunk closes: for each of the
+    /// side's four border lines, whether every chunk of this level holding the line faces a
+    /// coarser chunk across a side through it (and so gives the fine vertices there the coarse
+    /// normals too).
+    ///
+    /// Four chunks stand around a line (three at a cube corner, two on the shell's boundary).
+    /// Besides this chunk, one of its level holding the line but facing no coarser chunk can
+    /// only be the one diagonally opposite the coarse neighbour `y`. The line qualifies when this
+    /// chunk's neighbour across its other side through the line is its sibling (then the line
+    /// runs through the middle of `y`'s side: `y` fills both quadrants across the side, and the
+    /// sibling faces it too), when it is a cube corner (three chunks, each beside both others),
+    /// when no chunk lies beyond that other side (the shell's boundary), or when that other side
+    /// faces a coarser chunk too (then so do the diagonal chunk's two sides, if it is of this
+    /// level). Left out: `y`'s own edges along a straight level boundary, where the chunk beside
+    /// this one may face `y`'s neighbour or be of its own level and face nothing coarser, which
+    /// this chunk's side mask cannot tell apart.
+    fn shared_seam_borders(
+        &self,
+        grid: &ChunkGrid,
+        side: ChunkSide,
+        closing: &[(ChunkSide, ChunkKey)],
+    ) -> [[bool; 2]; 2] {
+        let key = grid.key;
+        let (p, n) = (grid.padded, grid.tiles);
+        let inplane = match side.axis() {
+            0 => [1, 2],
+            1 => [0, 2],
+            _ => [0, 1],
+        };
+        let at = if side.is_max() { n + 1 } else { 1 };
+        let face_tiles = self.layout.face_tiles();
+        inplane.map(|axis| {
+            [false, true].map(|high| {
+                let other = ChunkSide::ALL[2 * axis + usize::from(high)];
+                if closing.iter().any(|(s, _)| *s == other) {
+                    return true;
+                }
+                let Some(beside) = self.layout.neighbour(&key, other, key.level) else {
+                    return true;
+                };
+                if beside.parent() == key.parent() {
+                    return true;
+                }
+                // A radial line on a cube corner: its column's lattice point is a cube corner.
+                if axis == 2 || side.axis() == 2 {
+                    return false;
+                }
+                let end = if high { n + 1 } else { 1 };
+                let col = if side.axis() == 0 { end * p + at } else { at * p + end };
+                grid.lattice[col]
+                    .abs()
+                    .to_array()
+                    .iter()
+                    .all(|c| i64::from(*c) == face_tiles)
+            })
+        })
     }
 
     /// Meshes a chunk of any level with its seams closed toward coarser neighbours (allocating
