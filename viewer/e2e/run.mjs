@@ -30,6 +30,8 @@ import { CHROMIUM, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail
 import * as closeup from './scenarios/closeup.mjs';
 import * as editing from './scenarios/editing.mjs';
 import * as elevationModel from './scenarios/elevationModel.mjs';
+import * as imagery from './scenarios/imagery.mjs';
+import * as levelSwitch from './scenarios/levelSwitch.mjs';
 import * as lodDefault from './scenarios/lodDefault.mjs';
 import * as lodEarth from './scenarios/lodEarth.mjs';
 import * as newChunks from './scenarios/newChunks.mjs';
@@ -37,6 +39,8 @@ import * as pageLoads from './scenarios/pageLoads.mjs';
 import * as pathAndNavGrid from './scenarios/pathAndNavGrid.mjs';
 import * as planetDrawn from './scenarios/planetDrawn.mjs';
 import * as presetSwitch from './scenarios/presetSwitch.mjs';
+import * as seaByData from './scenarios/seaByData.mjs';
+import * as sky from './scenarios/sky.mjs';
 import * as viewsAndModes from './scenarios/viewsAndModes.mjs';
 import { startBackend } from './servers.mjs';
 
@@ -49,7 +53,7 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
  */
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
 /** Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API). */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel, sky, imagery, levelSwitch, seaByData];
 
 async function main() {
   if (!existsSync(join(distDir, 'index.html'))) throw new Error('viewer/dist is missing: run `npm run build` first');

@@ -4,6 +4,8 @@
 
 import * as THREE from 'three';
 import { PmcApi, type PlanetInfo } from './api';
+import type { SkySettings, SkyState } from './atmosphere';
+import { atmosphereOf } from './atmosphereModel';
 import type { CameraMode } from './cameraModel';
 import { CameraController, type PickResult } from './cameraController';
 import { ChunkStreamer } from './chunkStreamer';
@@ -18,6 +20,7 @@ import { NavGridLoader, groundPoint, navRange } from './navOverlay';
 import { NavScene } from './navScene';
 import { PATH_TOOL, PathTool, type PathStatus } from './pathTool';
 import { planetParams, type PlanetParams } from './planetParams';
+import { parseImagery, loadImageryTexture, type ImageryInfo } from './imagery';
 import { PlanetScene, type DebugFlags } from './planetScene';
 import { Readiness } from './readiness';
 import {
@@ -27,6 +30,7 @@ import {
   type ModeName,
   type PmcNavGridHook,
   type PmcPathHook,
+  type PmcPlace,
   type PmcStats,
   type TestHookTarget,
 } from './testHook';
@@ -45,6 +49,8 @@ export class App implements TestHookTarget {
   private readonly navLoader: NavGridLoader;
   /** The Path tool is chosen (the editor's tool is Look meanwhile). */
   private pathActive = false;
+  /** The imagery draped on the planet shown, if any. */
+  private imageryTexture: THREE.Texture | null = null;
   private pathDrawn = -1;
   private gridDrawn = -1;
   private navChanged = true;
@@ -79,6 +85,8 @@ export class App implements TestHookTarget {
       antialias: true,
       powerPreference: 'high-performance',
       logarithmicDepthBuffer: true,
+      // the terrain marks its pixels: the sea disk is drawn only where no terrain is
+      stencil: true,
     });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.renderer.outputColorSpace = THREE.SRGBColorSpace;
@@ -109,6 +117,7 @@ export class App implements TestHookTarget {
       onDebug: (flags) => this.setDebug(flags),
       onNavGrid: (on) => this.setNavGrid(on),
       onLod: (settings) => this.setLod(settings),
+      onSky: (settings) => void this.setSky(settings),
     });
     this.scene.scene.add(this.navScene.group);
     this.pathTool = new PathTool({
@@ -187,6 +196,7 @@ export class App implements TestHookTarget {
     this.ui.setMode(this.cameras.mode, this.cameras.walk);
     this.ui.setDebug(this.scene.debug());
     this.ui.setLod(this.selection.settings);
+    this.ui.setSky(this.scene.atmosphere.state());
     window.__pmc = createTestHook(this);
     this.loop.start();
     void this.loadPlanet(this.choice, true);
@@ -203,8 +213,15 @@ export class App implements TestHookTarget {
       try {
         const info = await this.api.planet(choice);
         if (request !== this.planetRequest) return;
+        const imagery = await this.loadImagery(info);
+        if (request !== this.planetRequest) {
+          imagery.texture?.dispose();
+          return;
+        }
         this.applyPlanet(info);
+        this.setImagery(imagery.texture, imagery.info);
         this.clearError();
+        if (imagery.error) this.showError(`The planet's imagery is not shown: ${imagery.error}`);
         return;
       } catch (e) {
         if (request !== this.planetRequest) return;
@@ -219,6 +236,24 @@ export class App implements TestHookTarget {
         if (request !== this.planetRequest) return;
       }
     }
+  }
+
+  /** The planet's imagery (`/planet`'s `imagery` block and its picture), or why there is none. */
+  private async loadImagery(info: PlanetInfo): Promise<{ texture: THREE.Texture | null; info: ImageryInfo | null; error: string | null }> {
+    try {
+      const imagery = parseImagery(info);
+      if (!imagery) return { texture: null, info: null, error: null };
+      const max = this.renderer.capabilities.maxTextureSize;
+      return { texture: await loadImageryTexture(imagery, document.baseURI, max), info: imagery, error: null };
+    } catch (e) {
+      return { texture: null, info: null, error: e instanceof Error ? e.message : String(e) };
+    }
+  }
+
+  private setImagery(texture: THREE.Texture | null, info: ImageryInfo | null): void {
+    if (this.imageryTexture && this.imageryTexture !== texture) this.imageryTexture.dispose();
+    this.imageryTexture = texture;
+    this.scene.setImagery(texture, info);
   }
 
   private applyPlanet(info: PlanetInfo): void {
@@ -236,6 +271,8 @@ export class App implements TestHookTarget {
     this.navRevision = this.editor.revision ?? 0;
     this.scene.clearChunks();
     this.scene.setPlanet(this.params);
+    this.scene.setAtmosphere(atmosphereOf(info, this.params.shape));
+    this.ui.setSky(this.scene.atmosphere.state());
     const shape = this.params.shape;
     if (!Number.isFinite(this.cameras.state.alt)) this.cameras.state.alt = 1.6 * shape.outer;
     this.cameras.clampAltitude(shape);
@@ -389,6 +426,19 @@ export class App implements TestHookTarget {
     this.navChanged = true;
   }
 
+  /** Up to `count` vertices of the chunks shown and where they show on the canvas (test hook). */
+  places(count: number): PmcPlace[] {
+    const cam = this.cameras.position;
+    return this.scene.sampleVertices(count).map((v) => {
+      const d: V3 = [cam[0] - v.point[0], cam[1] - v.point[1], cam[2] - v.point[2]];
+      const len = Math.hypot(d[0], d[1], d[2]) || 1;
+      const facing = (v.normal[0] * d[0] + v.normal[1] * d[1] + v.normal[2] * d[2]) / len;
+      const r = Math.hypot(v.point[0], v.point[1], v.point[2]) || 1;
+      const upFacing = (v.point[0] * d[0] + v.point[1] * d[1] + v.point[2] * d[2]) / (r * len);
+      return { ...v, screen: this.cameras.toScreen(v.point), facing, upFacing };
+    });
+  }
+
   /** The loaded terrain under canvas pixel (x, y), with the camera of the last frame. */
   pick(x: number, y: number): (PickResult & { render: V3 }) | null {
     if (!this.params) return null;
@@ -502,8 +552,17 @@ export class App implements TestHookTarget {
     this.cameras.setAspect(w / h);
   }
 
+  /** The sky panel's and the test hook's settings: atmosphere on or off, the sun's place. */
+  setSky(settings: Partial<SkySettings>): SkyState {
+    this.scene.setSkySettings(settings);
+    const state = this.scene.atmosphere.state();
+    this.ui.setSky(state);
+    return state;
+  }
+
   setDebug(flags: Partial<DebugFlags>): DebugFlags {
     this.scene.setDebug(flags);
+    this.ui.setSky(this.scene.atmosphere.state());
     this.ui.setDebug(this.scene.debug());
     return this.scene.debug();
   }

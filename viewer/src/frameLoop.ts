@@ -7,7 +7,7 @@ import * as THREE from 'three';
 import type { CameraController } from './cameraController';
 import { formatLevels } from './chunkSelection';
 import type { ChunkStreamer } from './chunkStreamer';
-import { addScaled, enuAt, length, normalize, type V3 } from './frames';
+import { length, type V3 } from './frames';
 import type { Input, InputFrame } from './input';
 import type { PlanetParams } from './planetParams';
 import type { PlanetScene } from './planetScene';
@@ -97,15 +97,16 @@ export class FrameLoop {
     steps.brush(input);
     steps.navigation(pos, params);
 
-    // sky: blue near the ground, black from orbit
+    // the background where nothing is drawn (the sky covers it where the atmosphere is drawn):
+    // on a planet with air a flat blue near the ground, black from orbit; black without air
     const r = length(pos);
     const aboveSea = r - (params.seaRadius ?? shape.datum);
     const skyT = (aboveSea - 0.04 * shape.datum) / (0.5 * shape.datum);
-    scene.setSky(1 - Math.max(0, Math.min(1, skyT)) ** 0.5);
+    scene.setSky(scene.atmosphere.kind() === null ? 0 : 1 - Math.max(0, Math.min(1, skyT)) ** 0.5);
 
-    // sun: above the camera's side of the planet, from the south-east-ish
-    const enu = enuAt(pos);
-    scene.setSun(normalize(addScaled(addScaled(enu.up, enu.east, 0.55), enu.north, 0.35)));
+    // sun: at the azimuth and elevation of the sky settings over the horizon under the camera
+    // (by default south-east-ish and well up); the atmosphere's place of the camera
+    scene.setSun(scene.atmosphere.frame(pos));
 
     // streaming: select for this view (when it changed), fetch and show
     const viewportHeightPx = renderer.getDrawingBufferSize(new THREE.Vector2()).y;

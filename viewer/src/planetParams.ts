@@ -1,10 +1,15 @@
 // Numbers the viewer derives from `/api/v1/planet`: the datum that altitudes and heights refer
-// to, the radial extent of the surface, and the shading parameters. Pure.
+// to, the radial extent of the surface, and the shading parameters (the material model and the
+// frequencies of the shader's place noises). Pure.
 
 import type { PlanetInfo, Vec3Tuple } from './api';
 import type { PlanetShape } from './cameraModel';
 import type { PlanetExtent } from './chunkSelection';
+import { materialModel, type MaterialModel } from './materials';
 import { NOISE_PERIOD_CELLS } from './shaders';
+
+/** Wavelength of the finest place noise's first octave (detail near the ground), metres. */
+export const DETAIL_WAVELENGTH = 4;
 
 export interface PlanetParams {
   shape: PlanetShape;
@@ -17,9 +22,16 @@ export interface PlanetParams {
   snowAmount: number;
   /** Metres of water that absorb most light. */
   waterScale: number;
-  /** Noise frequency, cycles per metre, and its period in metres. */
+  /** Noise frequency, cycles per metre, and its period in metres (two tiles per cycle). */
   noiseFreq: number;
   noisePeriod: number;
+  /** The detail noise near the ground: cycles per metre and period in metres. */
+  detailFreq: number;
+  detailPeriod: number;
+  /** The large-scale noise (forests, deserts): cells per unit of direction (about 40 tiles each). */
+  macroFreq: number;
+  /** The material model: one function of the place, this planet's parameters. */
+  materials: MaterialModel;
   /** Palette colours scaled to a mean luminance of 1 (multiplied into the vertex colour). */
   paletteA: Vec3Tuple;
   paletteB: Vec3Tuple;
@@ -38,7 +50,9 @@ export function planetParams(p: PlanetInfo): PlanetParams {
   const inner = Math.max(lowest, sea ?? -Infinity);
   const bandHeight = Math.max(1, outer - datum);
   const chunkWidth = ((Math.PI / 2) * datum) / Math.max(1, p.layout.n_c);
-  const noiseFreq = 2 / Math.max(1, chunkWidth);
+  const tile = chunkWidth / Math.max(1, p.layout.n_t);
+  const noiseFreq = 1 / Math.max(1e-3, 2 * tile);
+  const detailFreq = 1 / DETAIL_WAVELENGTH;
   const mean = Math.max(1e-3, (luminance(p.palette.a) + luminance(p.palette.b)) / 2);
   const norm = (c: Vec3Tuple): Vec3Tuple => [c[0] / mean, c[1] / mean, c[2] / mean];
   return {
@@ -51,6 +65,10 @@ export function planetParams(p: PlanetInfo): PlanetParams {
     waterScale: sea !== null ? Math.max(2, (sea - lowest) / 3) : 1,
     noiseFreq,
     noisePeriod: NOISE_PERIOD_CELLS / noiseFreq,
+    detailFreq,
+    detailPeriod: NOISE_PERIOD_CELLS / detailFreq,
+    macroFreq: datum / Math.max(1e-3, 40 * tile),
+    materials: materialModel(p, datum),
     paletteA: norm(p.palette.a),
     paletteB: norm(p.palette.b),
     chunkWidth,

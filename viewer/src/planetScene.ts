@@ -4,9 +4,13 @@
 // render origin, so nothing jitters at any planet radius.
 
 import * as THREE from 'three';
+import { Atmosphere, type SkySettings } from './atmosphere';
+import { SPACE, type AtmosphereParams } from './atmosphereModel';
 import type { DecodedChunk } from './chunkDecode';
 import { boundaryEdges } from './boundaryEdges';
 import { modPositive, relativeToCamera, type V3 } from './frames';
+import { imageryCellMetres, type ImageryInfo } from './imagery';
+import { materialUniforms } from './materials';
 import type { PlanetParams } from './planetParams';
 import { buildSeaDisk, seaDiskStale, type SeaDisk } from './seaGeometry';
 import { seaFragment, seaVertex, terrainFragment, terrainVertex } from './shaders';
@@ -21,10 +25,13 @@ export const FACE_COLOURS: [number, number, number][] = [
   [0.2, 0.85, 0.85],
 ];
 
+/** The stencil value every terrain pixel writes; the sea disk draws only where it is not. */
+const TERRAIN_STENCIL = 1;
+
 export const SKY_COLOUR = new THREE.Color(0.52, 0.66, 0.85); // linear, for aerial perspective
 /** Background near the ground (a clear sky) and far out (space), linear RGB. */
 const SKY_BACKGROUND = new THREE.Color(0.23, 0.42, 0.75);
-const SPACE_BACKGROUND = new THREE.Color(0.004, 0.006, 0.012);
+const SPACE_BACKGROUND = new THREE.Color(...SPACE);
 
 interface ChunkObject {
   key: string;
@@ -46,20 +53,52 @@ export interface DebugFlags {
    * back face can be seen, so a magenta pixel is a crack or a hole.
    */
   backfaces: boolean;
+  /** Sun and sky light and haze (off, test mode: the ground's colour alone, the same at every level). */
+  lighting: boolean;
+  /** The sea: water where the ground is below the datum, and the sea disk (off, test mode: neither). */
+  sea: boolean;
+}
+
+/** A vertex of a chunk shown (`PlanetScene.sampleVertices`). */
+export interface SampledVertex {
+  /** Planet frame, metres (f64: the chunk origin plus the f32 offset). */
+  point: V3;
+  /** Metres above the datum, and the lowest height of the triangles around it. */
+  height: number;
+  ringMin: number;
+  /** Unit normal. */
+  normal: V3;
+  key: string;
+  level: number;
 }
 
 export class PlanetScene {
   readonly scene = new THREE.Scene();
   private readonly terrainGroup = new THREE.Group();
   private readonly chunks = new Map<string, ChunkObject>();
+  /** The sky and the aerial perspective (atmosphere.ts); its uniforms are in every terrain material. */
+  readonly atmosphere = new Atmosphere();
   private readonly shared = {
+    ...this.atmosphere.uniforms,
     uSunDir: { value: new THREE.Vector3(0, 1, 0) },
-    uPaletteA: { value: new THREE.Vector3(1, 1, 1) },
-    uPaletteB: { value: new THREE.Vector3(1, 1, 1) },
-    uPaletteStrength: { value: 0.35 },
-    uBandHeight: { value: 100 },
-    uSnowHeight: { value: 60 },
-    uSnowAmount: { value: 1 },
+    uMatA: { value: Array.from({ length: 10 }, () => new THREE.Vector3(1, 1, 1)) },
+    uMatB: { value: Array.from({ length: 10 }, () => new THREE.Vector3(1, 1, 1)) },
+    uMatHeights: { value: new THREE.Vector4(1e30, 0, 1e30, 1e30) },
+    uMatSnow: { value: new THREE.Vector4(1e30, 1, 1, 1) },
+    uMatShares: { value: new THREE.Vector4(0, 0, -1e30, 0) },
+    uMatSlopes: { value: new THREE.Vector4(0.68, 0.5, 2, 0) },
+    uMatExtra: { value: new THREE.Vector2(0, 1) },
+    uMacroFreq: { value: 1 },
+    uDatum: { value: 1 },
+    uDetailFreq: { value: 0.25 },
+    uLighting: { value: 1 },
+    uHasSea: { value: 0 },
+    uWater: { value: 1 },
+    uSeaColour: { value: new THREE.Vector3(0.02, 0.13, 0.3) },
+    uImagery: { value: null as THREE.Texture | null },
+    uHasImagery: { value: 0 },
+    uImageryExtent: { value: new THREE.Vector4(-Math.PI, Math.PI, -Math.PI / 2, Math.PI / 2) },
+    uImageryCell: { value: 1 },
     uWaterShallow: { value: new THREE.Vector3(0.55, 0.8, 0.85) },
     uWaterDeep: { value: new THREE.Vector3(0.01, 0.05, 0.14) },
     uWaterScale: { value: 10 },
@@ -70,7 +109,16 @@ export class PlanetScene {
     uBackfaceFlag: { value: 0 },
   };
   private params: PlanetParams | null = null;
-  private flags: DebugFlags = { wireframe: false, faceColours: false, borders: false, backfaces: false };
+  private flags: DebugFlags = {
+    wireframe: false,
+    faceColours: false,
+    borders: false,
+    backfaces: false,
+    lighting: true,
+    sea: true,
+  };
+  /** A 1 x 1 stand-in for the imagery texture while a planet has none. */
+  private readonly noImagery = new THREE.DataTexture(new Uint8Array([128, 128, 128, 255]), 1, 1);
   private readonly borderMaterial = new THREE.LineBasicMaterial({
     color: 0xffee33,
     depthTest: true,
@@ -85,13 +133,24 @@ export class PlanetScene {
     fragmentShader: seaFragment,
     uniforms: {
       uSunDir: this.shared.uSunDir,
-      uSeaColour: { value: new THREE.Vector3(0.02, 0.13, 0.3) },
+      uSeaColour: this.shared.uSeaColour,
       uSkyColour: this.shared.uSkyColour,
+      uWaterDeep: this.shared.uWaterDeep,
       uFogDistance: this.shared.uFogDistance,
+      uLighting: this.shared.uLighting,
+      ...this.atmosphere.uniforms,
     },
     transparent: true,
     depthWrite: false,
     side: THREE.FrontSide,
+    // only where no terrain is drawn: the terrain draws the sea itself over ground below the
+    // datum, and the disk can never cover land (however coarse the mesh, however far the view)
+    stencilWrite: true,
+    stencilRef: TERRAIN_STENCIL,
+    stencilFunc: THREE.NotEqualStencilFunc,
+    stencilFail: THREE.KeepStencilOp,
+    stencilZFail: THREE.KeepStencilOp,
+    stencilZPass: THREE.KeepStencilOp,
   });
 
   private readonly background = SPACE_BACKGROUND.clone();
@@ -113,8 +172,10 @@ export class PlanetScene {
   });
 
   constructor() {
+    this.noImagery.needsUpdate = true;
     this.scene.background = this.background;
     this.scene.add(this.terrainGroup);
+    this.scene.add(this.atmosphere.sky);
     const ball = new THREE.Mesh(new THREE.SphereGeometry(1, 32, 16), this.cursorBallMaterial);
     ball.renderOrder = 20; // after the sea
     const ringPoints: THREE.Vector3[] = [];
@@ -167,14 +228,24 @@ export class PlanetScene {
   setPlanet(params: PlanetParams): void {
     this.params = params;
     const s = this.shared;
-    s.uPaletteA.value.set(...params.paletteA);
-    s.uPaletteB.value.set(...params.paletteB);
-    s.uBandHeight.value = params.bandHeight;
-    s.uSnowHeight.value = params.snowHeight;
-    s.uSnowAmount.value = params.snowAmount;
+    const m = materialUniforms(params.materials);
+    for (let i = 0; i < s.uMatA.value.length; i++) {
+      s.uMatA.value[i]!.fromArray(m.colourA, 3 * i);
+      s.uMatB.value[i]!.fromArray(m.colourB, 3 * i);
+    }
+    s.uMatHeights.value.set(...m.heights);
+    s.uMatSnow.value.set(...m.snow);
+    s.uMatShares.value.set(...m.shares);
+    s.uMatSlopes.value.set(...m.slopes);
+    s.uMatExtra.value.set(...m.extra);
+    s.uMacroFreq.value = params.macroFreq;
+    s.uDatum.value = params.shape.datum;
+    s.uDetailFreq.value = params.detailFreq;
+    s.uHasSea.value = params.seaRadius !== null ? 1 : 0;
     s.uWaterScale.value = params.waterScale;
     s.uNoiseFreq.value = params.noiseFreq;
-    s.uFogDistance.value = 6 * params.shape.outer;
+    this.setImagery(null, null);
+    this.syncFog();
     this.removeSea();
     if (params.seaRadius !== null) {
       const geometry = new THREE.BufferGeometry();
@@ -183,7 +254,7 @@ export class PlanetScene {
       this.sea.frustumCulled = false;
       this.sea.renderOrder = 10; // after the terrain
       this.sea.matrixAutoUpdate = true;
-      this.sea.visible = !this.flags.backfaces;
+      this.sea.visible = !this.flags.backfaces && this.flags.sea;
       this.scene.add(this.sea);
     }
   }
@@ -196,6 +267,24 @@ export class PlanetScene {
     }
     this.seaDisk = null;
     this.seaBuiltFor = null;
+  }
+
+  /** The planet's atmosphere (null: none, the black sky of space). */
+  setAtmosphere(params: AtmosphereParams | null): void {
+    this.atmosphere.setPlanet(params);
+    this.syncFog();
+  }
+
+  /** Changes the sky settings given (atmosphere, sun); returns them all. */
+  setSkySettings(settings: Partial<SkySettings>): SkySettings {
+    const all = this.atmosphere.set(settings);
+    this.syncFog();
+    return all;
+  }
+
+  /** The old haze toward a constant sky colour far away, where the atmosphere is not drawn. */
+  private syncFog(): void {
+    this.shared.uFogDistance.value = this.atmosphere.drawn() || !this.params ? 1e30 : 6 * this.params.shape.outer;
   }
 
   /** Sun direction (planet frame, unit). */
@@ -221,6 +310,7 @@ export class PlanetScene {
     g.computeBoundingBox();
 
     const period = this.params.noisePeriod;
+    const detailPeriod = this.params.detailPeriod;
     const material = new THREE.ShaderMaterial({
       vertexShader: terrainVertex,
       fragmentShader: terrainFragment,
@@ -234,9 +324,21 @@ export class PlanetScene {
             modPositive(origin[2], period),
           ),
         },
+        uOriginModDetail: {
+          value: new THREE.Vector3(
+            modPositive(origin[0], detailPeriod),
+            modPositive(origin[1], detailPeriod),
+            modPositive(origin[2], detailPeriod),
+          ),
+        },
         uFaceColour: { value: new THREE.Vector3(...(FACE_COLOURS[chunk.face] ?? [1, 1, 1])) },
       },
       wireframe: this.flags.wireframe,
+      // every terrain pixel marks the stencil: the sea disk is not drawn over it
+      stencilWrite: true,
+      stencilRef: TERRAIN_STENCIL,
+      stencilFunc: THREE.AlwaysStencilFunc,
+      stencilZPass: THREE.ReplaceStencilOp,
       // with the back-face flag on, faces seen from inside the solid are drawn (in magenta)
       side: this.flags.backfaces ? THREE.DoubleSide : THREE.FrontSide,
     });
@@ -304,7 +406,12 @@ export class PlanetScene {
     this.flags = next;
     this.shared.uDebugFace.value = next.faceColours ? 1 : 0;
     this.shared.uBackfaceFlag.value = next.backfaces ? 1 : 0;
-    if (this.sea) this.sea.visible = !next.backfaces;
+    this.shared.uLighting.value = next.lighting ? 1 : 0;
+    // the test modes draw no atmosphere: back faces, and the ground's colour without lighting
+    this.atmosphere.setSuppressed(next.backfaces || !next.lighting);
+    this.syncFog();
+    this.shared.uWater.value = next.sea ? 1 : 0;
+    if (this.sea) this.sea.visible = !next.backfaces && next.sea;
     for (const obj of this.chunks.values()) {
       const m = obj.mesh.material;
       m.wireframe = next.wireframe;
@@ -381,6 +488,78 @@ export class PlanetScene {
     return n;
   }
 
+  /**
+   * Drapes `texture` (the picture `info` describes) on the terrain, or none when null. The
+   * texture is the caller's (disposed by it).
+   */
+  setImagery(texture: THREE.Texture | null, info: ImageryInfo | null): void {
+    const s = this.shared;
+    if (!texture || !info || !this.params) {
+      s.uImagery.value = this.noImagery;
+      s.uHasImagery.value = 0;
+      return;
+    }
+    const rad = Math.PI / 180;
+    const [west, east, south, north] = info.extent;
+    s.uImagery.value = texture;
+    s.uHasImagery.value = 1;
+    s.uImageryExtent.value.set(west * rad, east * rad, south * rad, north * rad);
+    s.uImageryCell.value = imageryCellMetres(info, this.params.shape.datum);
+  }
+
+  /**
+   * Up to `count` vertices of the chunks shown, spread evenly over them (test hook): where they
+   * are, their height and the lowest height of the triangles around them.
+   */
+  sampleVertices(count: number): SampledVertex[] {
+    const objs = [...this.chunks.values()];
+    const total = objs.reduce((n, o) => n + o.mesh.geometry.getAttribute('position').count, 0);
+    const out: SampledVertex[] = [];
+    if (total === 0 || count <= 0) return out;
+    const stride = Math.max(1, Math.floor(total / count));
+    let seen = 0;
+    for (const o of objs) {
+      const g = o.mesh.geometry;
+      const pos = g.getAttribute('position');
+      const nrm = g.getAttribute('normal');
+      const hgt = g.getAttribute('aHeight');
+      const index = g.getIndex();
+      const n = pos.count;
+      // the lowest height of the triangles around each vertex
+      const ring = new Float64Array(n).fill(Infinity);
+      if (index) {
+        const ix = index.array as ArrayLike<number>;
+        for (let t = 0; t + 2 < ix.length; t += 3) {
+          const a = ix[t]!;
+          const b = ix[t + 1]!;
+          const c = ix[t + 2]!;
+          const lo = Math.min(hgt.getX(a), hgt.getX(b), hgt.getX(c));
+          ring[a] = Math.min(ring[a]!, lo);
+          ring[b] = Math.min(ring[b]!, lo);
+          ring[c] = Math.min(ring[c]!, lo);
+        }
+      }
+      const first = (stride - (seen % stride)) % stride;
+      for (let i = first; i < n && out.length < count; i += stride) {
+        if (ring[i] === Infinity) continue;
+        const nx = nrm.getX(i);
+        const ny = nrm.getY(i);
+        const nz = nrm.getZ(i);
+        const nl = Math.hypot(nx, ny, nz) || 1;
+        out.push({
+          point: [o.origin[0] + pos.getX(i), o.origin[1] + pos.getY(i), o.origin[2] + pos.getZ(i)],
+          height: hgt.getX(i),
+          ringMin: ring[i]!,
+          normal: [nx / nl, ny / nl, nz / nl],
+          key: o.key,
+          level: (o.mesh.userData['level'] as number | undefined) ?? 0,
+        });
+      }
+      seen += n;
+    }
+    return out;
+  }
+
   seaVisible(): boolean {
     return this.sea !== null;
   }
@@ -389,6 +568,8 @@ export class PlanetScene {
     this.clearChunks();
     this.removeSea();
     this.seaMaterial.dispose();
+    this.atmosphere.dispose();
+    this.noImagery.dispose();
     this.borderMaterial.dispose();
     this.cursorBallMaterial.dispose();
     this.cursorRingMaterial.dispose();

@@ -3,6 +3,8 @@
 // origin (floating origin): directions are planet-frame directions, and the view vector of a
 // fragment is minus its render-space position.
 
+import { ATMOSPHERE_GLSL } from './atmosphere';
+
 /**
  * 3D value noise with a lattice period of 289 cells in every axis (a permutation polynomial
  * mod 289, exact in f32). Sampled at `(origin mod P) + position` with P a multiple of the period,
@@ -41,6 +43,27 @@ float pmcFbm(vec3 p) {
 /** Cells of the noise lattice per period: the period in metres is NOISE_PERIOD_CELLS / frequency. */
 export const NOISE_PERIOD_CELLS = 289;
 
+/**
+ * The sea surface over what lies below it (`below`, linear RGB) at unit normal `n` seen along unit
+ * `v` (toward the eye): the surface's colour and sky reflection (Fresnel) and the sun's glint,
+ * blended over `below` by the surface's opacity (nearly clear looking down, opaque at grazing
+ * angles), which is returned in `.a`. The terrain shader draws it over ground below the datum, the
+ * sea disk where no ground lies behind the surface, so both look the same.
+ */
+const SEA_SURFACE = /* glsl */ `
+vec4 pmcSeaSurface(vec3 below, vec3 n, vec3 v) {
+  float cosV = clamp(dot(n, v), 0.0, 1.0);
+  float fresnel = 0.02 + 0.98 * pow(1.0 - cosV, 5.0);
+  float diffuse = max(dot(n, uSunDir), 0.0);
+  vec3 hv = normalize(uSunDir + v);
+  float spec = pow(max(dot(n, hv), 0.0), 120.0) * step(0.0, diffuse);
+  vec3 colour = uSeaColour * (0.35 + 0.65 * diffuse);
+  colour = mix(colour, uSkyColour, fresnel * 0.8) + vec3(1.0, 0.97, 0.9) * spec * 0.8;
+  float alpha = clamp(0.35 + 0.55 * pow(1.0 - cosV, 2.0) + spec, 0.0, 0.96);
+  return vec4(mix(below, colour, alpha), alpha);
+}
+`;
+
 export const terrainVertex = /* glsl */ `
 attribute vec4 aColor;
 attribute float aHeight;
@@ -49,6 +72,8 @@ attribute float aMaterial;
 uniform vec3 uOrigin;     // chunk origin (f32: used for directions only)
 uniform vec3 uOriginMod;  // chunk origin modulo the noise period (computed in f64)
 uniform float uNoiseFreq;
+uniform vec3 uOriginModDetail; // chunk origin modulo the detail noise's period (computed in f64)
+uniform float uDetailFreq;
 varying vec3 vColor;
 varying float vHeight;
 varying float vWater;
@@ -56,11 +81,13 @@ varying vec3 vNormal;
 varying vec3 vNoisePos;
 varying vec3 vUp;
 varying vec3 vRel;
+varying vec3 vDetailPos;
 #include <common>
 #include <logdepthbuf_pars_vertex>
 void main() {
   vec4 world = modelMatrix * vec4(position, 1.0);
   vRel = world.xyz;
+  vDetailPos = (uOriginModDetail + position) * uDetailFreq;
   vColor = aColor.rgb;
   vHeight = aHeight;
   vWater = aWaterDepth;
@@ -74,20 +101,38 @@ void main() {
 
 export const terrainFragment = /* glsl */ `
 uniform vec3 uSunDir;
-uniform vec3 uPaletteA;
-uniform vec3 uPaletteB;
-uniform float uPaletteStrength;
-uniform float uBandHeight;   // metres: scale of the height bands
-uniform float uSnowHeight;   // metres above the datum where snow starts
-uniform float uSnowAmount;   // 0..1
-uniform vec3 uWaterShallow;
-uniform vec3 uWaterDeep;
-uniform float uWaterScale;   // metres of water that absorb most light
 uniform float uDebugFace;
 uniform vec3 uFaceColour;
 uniform vec3 uSkyColour;
 uniform float uFogDistance;
 uniform float uBackfaceFlag; // test mode: back faces (the inside of the solid) in pure magenta
+uniform float uLighting;     // 1: sun and sky light; 0 (test mode): the albedo alone, no haze
+uniform float uNoiseFreq;    // the place noise: cycles per metre (vNoisePos)
+uniform float uDetailFreq;   // the detail noise near the ground: cycles per metre (vDetailPos)
+uniform float uMacroFreq;    // the large-scale noise: cells per unit of direction
+uniform float uDatum;        // radius of the datum, metres
+// the material model (viewer/src/materials.ts): two colours per material, indexed as
+// MATERIAL_SLOTS (deep, shelf, shore, low, forest, dry, rock, snow, dark, ice); heights in metres
+// above the datum
+uniform vec3 uMatA[10];
+uniform vec3 uMatB[10];
+uniform vec4 uMatHeights;    // shelf depth, shore height, forest-from height, tree line (of the snow line)
+uniform vec4 uMatSnow;       // snow line at the equator, k, q, p: line (1 - k sin^(2q) lat)^p
+uniform vec4 uMatShares;     // forest share, dry share, dark height, dark share
+uniform vec4 uMatSlopes;     // rock below this cos(slope), snow above it, ice from |sin lat|, line jitter (m)
+uniform vec2 uMatExtra;      // lowest snow line, width of a height transition (m)
+// the sea, decided per pixel from the interpolated height
+uniform float uHasSea;       // the planet has a sea at the datum
+uniform float uWater;        // draw water where the height is below the datum (0: test mode)
+uniform vec3 uWaterShallow;
+uniform vec3 uWaterDeep;
+uniform float uWaterScale;   // metres of water that absorb most light
+uniform vec3 uSeaColour;
+// imagery draped by latitude and longitude (viewer/src/imagery.ts)
+uniform sampler2D uImagery;
+uniform float uHasImagery;
+uniform vec4 uImageryExtent; // west, east, south, north, radians (cell edges)
+uniform float uImageryCell;  // metres of one picture cell on the ground
 varying vec3 vColor;
 varying float vHeight;
 varying float vWater;
@@ -95,9 +140,107 @@ varying vec3 vNormal;
 varying vec3 vNoisePos;
 varying vec3 vUp;
 varying vec3 vRel;
+varying vec3 vDetailPos;
 #include <common>
 #include <logdepthbuf_pars_fragment>
 ${NOISE}
+${SEA_SURFACE}
+${ATMOSPHERE_GLSL}
+// Weight of a noise octave whose coordinate moves by fw cells per pixel: 1 while a cell spans
+// several pixels, 0 where it would alias.
+float pmcResolved(float fw) { return 1.0 - smoothstep(0.12, 0.45, fw); }
+// Octaves at f, 2f, ... 2^(n-1) f of value noise around 0.5, each faded out below the pixel;
+// fw: cells of the first octave per pixel.
+float pmcFiltered(vec3 q, int octaves, float fw) {
+  float sum = 0.0;
+  float amp = 0.5;
+  float scale = 1.0;
+  for (int i = 0; i < 6; i++) {
+    if (i >= octaves) break;
+    sum += amp * pmcResolved(fw * scale) * (pmcValueNoise(q * scale + float(i) * 17.0) - 0.5);
+    amp *= 0.5;
+    scale *= 2.0;
+  }
+  return 0.5 + sum;
+}
+vec3 pmcMat(int i, float t) { return mix(uMatA[i], uMatB[i], t); }
+// 0 below the line, 1 above it, a smooth step of half-width w; lines at +-1e30 are absent.
+float pmcAbove(float x, float line, float w) {
+  if (line > 1e29) return 0.0;
+  if (line < -1e29) return 1.0;
+  return smoothstep(line - w, line + w, x);
+}
+// A share (0..1) of the places by a noise value around 0.5.
+float pmcShare(float n, float share) {
+  if (share <= 0.0) return 0.0;
+  float th = 0.5 + 0.3 * (0.5 - share);
+  return smoothstep(th - 0.03, th + 0.03, n);
+}
+// The albedo of the ground at height h (m above the datum) along the unit direction up, with
+// cos(slope) slope, palette mix t, line jitter jit (-1..1), large-scale noises m1, m2, seen at
+// mpp metres per pixel. Height lines are smooth steps, and slopes count less as the pixel grows
+// past a tile (a coarse level smooths them): a place's colour hardly changes with the level drawn.
+vec3 pmcGround(float h, vec3 up, float slope, float t, float jit, float m1, float m2, float mpp) {
+  float w = uMatExtra.y;
+  float tile = 0.5 / max(uNoiseFreq, 1e-9);
+  float slopeWeight = 1.0 - smoothstep(0.1, 1.0, mpp / tile);
+  if (uHasSea > 0.5 && h < 0.0) {
+    float deep = uMatHeights.x > 1e29 ? 0.0 : smoothstep(0.7 * uMatHeights.x, 1.3 * uMatHeights.x, -h);
+    return mix(pmcMat(1, t), pmcMat(0, t), deep);
+  }
+  float hj = h + jit * uMatSlopes.w;
+  float s2 = up.y * up.y;
+  float snowLine = uMatSnow.x > 1e29 ? 1e30
+    : max(uMatExtra.x, uMatSnow.x * pow(max(0.0, 1.0 - uMatSnow.y * pow(s2, uMatSnow.z)), uMatSnow.w));
+  float treeLine = snowLine > 1e29 || uMatHeights.w > 1e29 ? 1e30 : uMatHeights.w * snowLine;
+  // lowlands: grass, forest in large patches and above the forest line
+  vec3 c = pmcMat(3, t);
+  float forest = max(pmcShare(m1, uMatShares.x), pmcAbove(hj, uMatHeights.z, w));
+  c = mix(c, pmcMat(4, t), forest);
+  // deserts, mostly in the subtropics (|sin lat| near 0.42), below 0.6 of the snow line
+  float subtropics = 1.0 - smoothstep(0.0, 0.25, abs(abs(up.y) - 0.42));
+  float dry = pmcShare(m2 + 0.1 * subtropics, uMatShares.y) * (1.0 - pmcAbove(hj, 0.6 * snowLine, w));
+  c = mix(c, pmcMat(5, t), dry);
+  // the dark material: low basins (maria, canyon floors) and patches (dunes)
+  float dark = max(1.0 - pmcAbove(hj, uMatShares.z, w), pmcShare(m2, uMatShares.w));
+  c = mix(c, pmcMat(8, t), dark);
+  // sand on the shore
+  float sw = 0.5 * uMatHeights.y;
+  float shore = uMatHeights.y > 0.0 ? 1.0 - smoothstep(uMatHeights.y - sw, uMatHeights.y + sw, h + 0.3 * jit * uMatHeights.y) : 0.0;
+  c = mix(c, pmcMat(2, t), shore);
+  // rock above the tree line and on steep slopes
+  float steep = (1.0 - smoothstep(uMatSlopes.x - 0.1, uMatSlopes.x + 0.1, slope)) * slopeWeight;
+  c = mix(c, pmcMat(6, t), max(pmcAbove(hj, treeLine, w), steep));
+  // snow above the snow line and polar ice, on gentle slopes
+  float gentle = 1.0 - (1.0 - smoothstep(uMatSlopes.y - 0.1, uMatSlopes.y + 0.1, slope)) * slopeWeight;
+  c = mix(c, pmcMat(7, t), pmcAbove(hj, snowLine, w) * gentle);
+  float ice = uMatSlopes.z > 1.0 ? 0.0 : smoothstep(uMatSlopes.z - 0.02, uMatSlopes.z + 0.02, abs(up.y) + 0.03 * jit);
+  c = mix(c, pmcMat(9, t), ice * gentle);
+  return c;
+}
+// The picture's colour at the unit direction up (linear RGB), its weight in .a (0 outside the
+// extent). Longitude per pixel, modulo 360 into the extent; the texture's gradients taken from
+// whichever of two longitude origins has no wrap inside the pixel's quad (no seam at the
+// antimeridian).
+vec4 pmcImagery(vec3 up) {
+  float lat = asin(clamp(up.y, -1.0, 1.0));
+  float lon = atan(up.x, up.z);
+  float span = uImageryExtent.y - uImageryExtent.x;
+  float u = mod(lon - uImageryExtent.x, 2.0 * PI) / span;
+  float u2 = mod(lon - uImageryExtent.x + PI, 2.0 * PI) / span;
+  float v = (lat - uImageryExtent.z) / (uImageryExtent.w - uImageryExtent.z);
+  vec2 gx = vec2(dFdx(u), dFdx(v));
+  vec2 gy = vec2(dFdy(u), dFdy(v));
+  float gx2 = dFdx(u2);
+  float gy2 = dFdy(u2);
+  if (abs(gx2) + abs(gy2) < abs(gx.x) + abs(gy.x)) {
+    gx.x = gx2;
+    gy.x = gy2;
+  }
+  float inside = step(u, 1.0) * step(0.0, v) * step(v, 1.0);
+  vec3 c = textureGrad(uImagery, vec2(u, v), gx, gy).rgb;
+  return vec4(c, inside);
+}
 void main() {
   #include <logdepthbuf_fragment>
   if (uBackfaceFlag > 0.5 && !gl_FrontFacing) {
@@ -111,38 +254,61 @@ void main() {
   }
   vec3 n = normalize(vNormal);
   vec3 up = normalize(vUp);
-  float noise = pmcFbm(vNoisePos);
-  vec3 base = vColor;
-  // the planet's two-colour blend, mixed by noise that is continuous across chunks
-  vec3 blend = mix(uPaletteA, uPaletteB, smoothstep(0.25, 0.75, noise));
-  base = mix(base, base * blend, uPaletteStrength); // palette normalised to mean luminance 1
-  // height bands: low ground a touch darker, high ground a touch brighter
-  float band = clamp(vHeight / max(uBandHeight, 1e-3), -1.0, 1.0);
-  base *= 0.9 + 0.18 * band;
-  // snow on gentle slopes above the snow line, its edge broken up by the noise
-  float gentle = smoothstep(0.55, 0.8, dot(n, up));
-  float snow = smoothstep(uSnowHeight, uSnowHeight + 0.15 * uBandHeight,
-                          vHeight + (noise - 0.5) * 0.2 * uBandHeight);
-  base = mix(base, vec3(0.92, 0.94, 0.97), snow * gentle * uSnowAmount);
-  if (uDebugFace > 0.5) base = uFaceColour * (0.75 + 0.25 * noise);
+  float h = vHeight;
+  float slope = dot(n, up);
+  // The pixel's footprint, metres: its distance times the angle a pixel subtends (the change of
+  // the view ray's direction from one pixel to the next, whatever the surface's orientation). It
+  // depends on the view alone, never on the triangles drawn, so every filter below gives a place
+  // the same colour at every level of detail.
+  vec3 ray = normalize(vRel);
+  float metresPerPixel = length(vRel) * max(length(dFdx(ray)), length(dFdy(ray)));
+  // the place's noises: fixed frequencies of the planet, filtered by the pixel's footprint
+  float meso = pmcFiltered(vNoisePos, 6, metresPerPixel * uNoiseFreq);
+  float jit = 2.0 * (pmcFiltered(vNoisePos * 0.25 + 31.0, 3, 0.25 * metresPerPixel * uNoiseFreq) - 0.5) * 2.0;
+  float m1 = pmcFiltered(up * uMacroFreq, 4, metresPerPixel * uMacroFreq / max(uDatum, 1.0));
+  float m2 = pmcFiltered(up * (0.31 * uMacroFreq) + 53.0, 4, 0.31 * metresPerPixel * uMacroFreq / max(uDatum, 1.0));
+  float detail = pmcFiltered(vDetailPos, 4, metresPerPixel * uDetailFreq);
+  float t = clamp(0.5 + 2.5 * (meso - 0.5), 0.0, 1.0);
+  vec3 base = pmcGround(h, up, slope, t, clamp(jit, -1.0, 1.0), m1, m2, metresPerPixel);
+  bool underwater = uHasSea > 0.5 && h < 0.0;
+  // (sampled outside the branch: texture gradients need the whole pixel quad)
+  vec4 img = uHasImagery > 0.5 ? pmcImagery(up) : vec4(0.0);
+  if (uHasImagery > 0.5 && !underwater) {
+    // metres per pixel against the picture's cell: below its resolution, the procedural detail
+    float below = 1.0 - smoothstep(0.05, 0.5, metresPerPixel / max(uImageryCell, 1e-3));
+    vec3 draped = img.rgb * (1.0 + 0.6 * (t - 0.5) * below);
+    float steep = 1.0 - smoothstep(uMatSlopes.x - 0.06, uMatSlopes.x + 0.06, slope);
+    draped = mix(draped, pmcMat(6, t), 0.6 * steep * below);
+    base = mix(base, draped, img.a);
+  }
+  // detail near the ground (mean 1: nothing from afar)
+  base *= 1.0 + 0.3 * (detail - 0.5);
+  if (uDebugFace > 0.5) base = uFaceColour * (0.75 + 0.25 * meso);
 
-  // sun and sky light
-  float diffuse = max(dot(n, uSunDir), 0.0);
-  float sky = 0.5 + 0.5 * dot(n, up);
-  vec3 lit = base * (0.15 + 0.2 * sky + 0.72 * diffuse);
-
-  // under the sea: absorbed along the path through the water
-  if (vWater > 0.0) {
+  vec3 lit = base;
+  if (uLighting > 0.5) {
+    float diffuse = max(dot(n, uSunDir), 0.0);
+    float sky = 0.5 + 0.5 * dot(n, up);
+    lit = base * (0.15 + 0.2 * sky + 0.72 * diffuse);
+  }
+  // the sea, where the ground is below the datum: absorbed along the path through the water,
+  // under the surface that the sea disk draws where no ground is behind it
+  if (underwater && uWater > 0.5) {
     vec3 v = normalize(-vRel);
     float cosView = max(abs(dot(v, up)), 0.2);
-    float path = vWater * 0.5 * (1.0 + 1.0 / cosView);
+    float path = -h * 0.5 * (1.0 + 1.0 / cosView);
     float k = 1.0 - exp(-path / max(uWaterScale, 1e-3));
     lit = mix(lit * uWaterShallow, uWaterDeep, k);
+    if (uLighting > 0.5) lit = pmcSeaSurface(lit, up, v).rgb;
   }
-  // a little aerial perspective far away
-  float fog = 1.0 - exp(-length(vRel) / max(uFogDistance, 1.0));
-  lit = mix(lit, uSkyColour, 0.35 * fog);
-  gl_FragColor = vec4(lit, 1.0);
+  if (uLighting > 0.5) {
+    // a little aerial perspective far away
+    float fog = 1.0 - exp(-length(vRel) / max(uFogDistance, 1.0));
+    lit = mix(lit, uSkyColour, 0.35 * fog);
+  }
+  // the terrain's final colour (linear RGB), before the output transform
+  vec3 pmcColour = pmcAerialPerspective(lit, vRel); // atmosphere.ts: off without air and in test modes
+  gl_FragColor = vec4(pmcColour, 1.0);
   #include <colorspace_fragment>
 }
 `;
@@ -165,28 +331,34 @@ export const seaFragment = /* glsl */ `
 uniform vec3 uSunDir;
 uniform vec3 uSeaColour;
 uniform vec3 uSkyColour;
+uniform vec3 uWaterDeep;
 uniform float uFogDistance;
+uniform float uLighting;
 varying vec3 vNormal;
 varying vec3 vRel;
 #include <common>
 #include <logdepthbuf_pars_fragment>
+${SEA_SURFACE}
+${ATMOSPHERE_GLSL}
 void main() {
   #include <logdepthbuf_fragment>
   vec3 n = normalize(vNormal);
-  if (!gl_FrontFacing) n = -n;
   vec3 v = normalize(-vRel);
-  float cosV = clamp(dot(n, v), 0.0, 1.0);
-  float fresnel = 0.02 + 0.98 * pow(1.0 - cosV, 5.0);
-  float diffuse = max(dot(n, uSunDir), 0.0);
-  vec3 h = normalize(uSunDir + v);
-  float spec = pow(max(dot(n, h), 0.0), 120.0) * step(0.0, diffuse);
-  vec3 colour = uSeaColour * (0.35 + 0.65 * diffuse);
-  colour = mix(colour, uSkyColour, fresnel * 0.8) + vec3(1.0, 0.97, 0.9) * spec * 0.8;
-  // nearly clear looking down, opaque at grazing angles
-  float alpha = clamp(0.35 + 0.55 * pow(1.0 - cosV, 2.0) + spec, 0.0, 0.96);
-  float fog = 1.0 - exp(-length(vRel) / max(uFogDistance, 1.0));
-  colour = mix(colour, uSkyColour, 0.35 * fog);
-  gl_FragColor = vec4(colour, alpha);
+  // Drawn only where no terrain is (the stencil): from above, the surface over deep water, as the
+  // terrain shader draws it over the sea floor; from below (the camera under the sea), the
+  // surface seen through, over the background.
+  vec4 sea;
+  if (gl_FrontFacing) {
+    sea = uLighting > 0.5 ? vec4(pmcSeaSurface(uWaterDeep, n, v).rgb, 1.0) : vec4(uWaterDeep, 1.0);
+  } else {
+    sea = pmcSeaSurface(vec3(0.0), -n, v);
+    sea.rgb = sea.a > 0.0 ? sea.rgb / sea.a : sea.rgb;
+  }
+  if (uLighting > 0.5) {
+    float fog = 1.0 - exp(-length(vRel) / max(uFogDistance, 1.0));
+    sea.rgb = mix(sea.rgb, uSkyColour, 0.35 * fog);
+  }
+  gl_FragColor = vec4(pmcAerialPerspective(sea.rgb, vRel), sea.a);
   #include <colorspace_fragment>
 }
 `;

@@ -2,6 +2,7 @@
 // hook made from the application's operations, and the Path tool's and the nav grid's state as
 // the hook shows them (where they lie on the canvas).
 
+import type { SkySettings, SkyState } from './atmosphere';
 import type { CameraMode } from './cameraModel';
 import type { PickResult } from './cameraController';
 import type { StreamerStats } from './chunkStreamer';
@@ -9,7 +10,7 @@ import type { EditStatus } from './editSession';
 import type { V3 } from './frames';
 import type { NavGridStatus, NavOverlayData } from './navOverlay';
 import type { PathStatus } from './pathTool';
-import type { DebugFlags } from './planetScene';
+import type { DebugFlags, SampledVertex } from './planetScene';
 import type { Readiness } from './readiness';
 import type { LodSettings } from './viewSelection';
 
@@ -74,6 +75,16 @@ export interface PmcStats {
   pathTool: boolean;
 }
 
+/** `__pmc.places()`: a vertex of a chunk shown and where it shows on the canvas. */
+export interface PmcPlace extends SampledVertex {
+  /** CSS pixels from the top left, null where behind the camera. */
+  screen: [number, number] | null;
+  /** Cosine of the angle between the vertex normal and the direction to the camera. */
+  facing: number;
+  /** The same for the local vertical (small toward the planet's limb). */
+  upFacing: number;
+}
+
 /** `__pmc.path()`: the Path tool's state, and where the path drawn lies on the canvas. */
 export interface PmcPathHook extends Omit<PathStatus, 'waypoints' | 'line' | 'from' | 'to'> {
   /** The ends as sent to `/path` (`LAT,LON,ALT`), null when not set. */
@@ -112,14 +123,32 @@ export interface PmcTestHook {
   setPlanet(preset: string, seed: string | number): Promise<void>;
   /** Switches to `name` ('orbit', 'fly' or 'walk') when given; returns the current mode. */
   mode(name?: ModeName): ModeName;
+  /**
+   * Sets debug flags and test modes; returns them all. `lighting: false` draws the ground's colour
+   * alone (no sun, no haze), `sea: false` no water.
+   */
   debug(flags: Partial<DebugFlags>): DebugFlags;
+  /** Up to `count` vertices of the chunks shown, spread over them, and where they show. */
+  places(count: number): PmcPlace[];
   /** The loaded terrain under canvas pixel (x, y) (CSS pixels from the top left), or null. */
   pick(x: number, y: number): PickResult | null;
   /** The Path tool's state (see PmcPathHook). */
   path(): PmcPathHook;
   /** Turns the nav grid overlay on or off when `on` is given; returns its state. */
   navgrid(on?: boolean): PmcNavGridHook;
-  /** Sets the largest screen-space error (pixels) and the chunk budget when given; returns them. */
+  /**
+   * The sky: sets the settings given (`atmosphere` on or off, the sun's `sunAzimuth` and
+   * `sunElevation` in degrees over the horizon under the camera); returns the state (also the
+   * planet's atmosphere `kind`, whether it is `drawn` and the `sunDirection`).
+   */
+  sky(settings?: Partial<SkySettings>): SkyState;
+  /** Turns the atmosphere on or off (`sky({ atmosphere: on })`); returns the state. */
+  setAtmosphere(on: boolean): SkyState;
+  /**
+   * Sets the largest screen-space error (pixels), the chunk budget and the finest level when given
+   * (a test mode forces level L everywhere with `{ finestLevel: L, maxPixelError: 0.01 }`);
+   * returns them.
+   */
   lod(settings?: Partial<LodSettings>): LodSettings;
 }
 
@@ -142,10 +171,13 @@ export interface TestHookTarget {
   modeName(): ModeName;
   /** Sets debug flags; returns them all. */
   setDebug(flags: Partial<DebugFlags>): DebugFlags;
+  places(count: number): PmcPlace[];
   pick(x: number, y: number): PickResult | null;
   pathHook(): PmcPathHook;
   navGridHook(): PmcNavGridHook;
   setNavGrid(on: boolean): void;
+  /** Sets the sky settings given; returns the sky's state. */
+  setSky(settings: Partial<SkySettings>): SkyState;
   setLod(settings: Partial<LodSettings>): void;
   lodSettings(): LodSettings;
 }
@@ -172,6 +204,7 @@ export function createTestHook(app: TestHookTarget): PmcTestHook {
       return app.modeName();
     },
     debug: (flags) => app.setDebug(flags),
+    places: (count) => app.places(count),
     pick: (x, y) => {
       const p = app.pick(x, y);
       return p ? { distance: p.distance, point: p.point, key: p.key } : null;
@@ -181,6 +214,8 @@ export function createTestHook(app: TestHookTarget): PmcTestHook {
       if (on !== undefined) app.setNavGrid(on);
       return app.navGridHook();
     },
+    sky: (settings) => app.setSky(settings ?? {}),
+    setAtmosphere: (on) => app.setSky({ atmosphere: on }),
     lod: (settings) => {
       if (settings) app.setLod(settings);
       return { ...app.lodSettings() };

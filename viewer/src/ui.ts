@@ -1,6 +1,7 @@
 // The DOM panels of index.html: stats, planet picker, mode switch, debug toggles, loading
 // indicator and error banner. Plain DOM, no framework.
 
+import type { SkySettings, SkyState } from './atmosphere';
 import type { CameraMode } from './cameraModel';
 import type { PresetInfo } from './api';
 import type { DebugFlags } from './planetScene';
@@ -15,6 +16,8 @@ export interface UiCallbacks {
   onNavGrid(on: boolean): void;
   /** The detail fields: largest screen-space error in pixels, chunk budget. */
   onLod(settings: { maxPixelError?: number; maxChunks?: number }): void;
+  /** The sky fields: the atmosphere checkbox, the sun's elevation and azimuth (degrees). */
+  onSky(settings: Partial<SkySettings>): void;
 }
 
 export interface StatsView {
@@ -62,6 +65,12 @@ export class Ui {
   private readonly pixelError = byId<HTMLInputElement>('lod-px');
   private readonly budget = byId<HTMLInputElement>('lod-budget');
   private readonly navgrid = byId<HTMLInputElement>('navgrid');
+  private readonly atmosphere = byId<HTMLInputElement>('atmosphere');
+  private readonly skyKind = byId<HTMLSpanElement>('sky-kind');
+  private readonly sunElevation = byId<HTMLInputElement>('sun-elevation');
+  private readonly sunElevationValue = byId<HTMLOutputElement>('sun-elevation-value');
+  private readonly sunAzimuth = byId<HTMLInputElement>('sun-azimuth');
+  private readonly sunAzimuthValue = byId<HTMLOutputElement>('sun-azimuth-value');
   private readonly navgridStatus = byId<HTMLParagraphElement>('navgrid-status');
   private shownNavGrid = '';
   private readonly loading = byId<HTMLDivElement>('loading');
@@ -123,6 +132,9 @@ export class Ui {
     };
     lodField(this.pixelError, (v) => this.callbacks.onLod({ maxPixelError: v }), (v) => Number.isFinite(v) && v > 0);
     lodField(this.budget, (v) => this.callbacks.onLod({ maxChunks: v }), (v) => Number.isInteger(v) && v >= 1);
+    this.atmosphere.addEventListener('change', () => this.callbacks.onSky({ atmosphere: this.atmosphere.checked }));
+    this.sunElevation.addEventListener('input', () => this.callbacks.onSky({ sunElevation: Number(this.sunElevation.value) }));
+    this.sunAzimuth.addEventListener('input', () => this.callbacks.onSky({ sunAzimuth: Number(this.sunAzimuth.value) }));
     this.navgrid.addEventListener('change', () => {
       this.callbacks.onNavGrid(this.navgrid.checked);
       this.navgrid.blur();
@@ -173,6 +185,16 @@ export class Ui {
     this.faces.checked = flags.faceColours;
     this.borders.checked = flags.borders;
     this.backfaces.checked = flags.backfaces;
+  }
+
+  /** The sky fields: the atmosphere checkbox, the planet's air, the sun's place. */
+  setSky(s: SkyState): void {
+    this.atmosphere.checked = s.atmosphere;
+    this.skyKind.textContent = s.kind === null ? 'none on this planet' : s.drawn ? s.kind : `${s.kind} (not drawn)`;
+    if (document.activeElement !== this.sunElevation) this.sunElevation.value = String(s.sunElevation);
+    if (document.activeElement !== this.sunAzimuth) this.sunAzimuth.value = String(s.sunAzimuth);
+    this.sunElevationValue.textContent = `${s.sunElevation.toFixed(1)}°`;
+    this.sunAzimuthValue.textContent = `${s.sunAzimuth.toFixed(0)}°`;
   }
 
   /** The detail fields. */

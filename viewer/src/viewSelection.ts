@@ -15,9 +15,11 @@ import { planesToPlanetFrame, sameView, type LodSelector, type SelectionResult, 
 export interface LodSettings {
   maxPixelError: number;
   maxChunks: number;
+  /** The finest level the selection may reach (0 but in a test mode that forces coarser levels). */
+  finestLevel: number;
 }
 
-export const DEFAULT_LOD: LodSettings = { maxPixelError: 2, maxChunks: 2500 };
+export const DEFAULT_LOD: LodSettings = { maxPixelError: 2, maxChunks: 2500, finestLevel: 0 };
 
 export class ViewSelection {
   private lodPlanet: LodPlanet | null = null;
@@ -53,10 +55,12 @@ export class ViewSelection {
   setSettings(settings: Partial<LodSettings>): void {
     const px = settings.maxPixelError ?? this.settings.maxPixelError;
     const budget = settings.maxChunks ?? this.settings.maxChunks;
+    const finest = settings.finestLevel ?? this.settings.finestLevel;
     if (!(Number.isFinite(px) && px > 0) || !(Number.isInteger(budget) && budget >= 1)) {
       throw new Error('the pixel error must be a number above 0 and the chunk budget a whole number of at least 1');
     }
-    this.settings = { maxPixelError: px, maxChunks: budget };
+    if (!(Number.isInteger(finest) && finest >= 0)) throw new Error('the finest level must be a whole number of at least 0');
+    this.settings = { maxPixelError: px, maxChunks: budget, finestLevel: finest };
   }
 
   /** A selection arrived. */
@@ -98,7 +102,7 @@ export class ViewSelection {
       },
       params: {
         maxPixelError: this.settings.maxPixelError,
-        finestLevel: 0,
+        finestLevel: this.settings.finestLevel,
         // a server without levels of detail: every level-0 chunk, however many the budget allows
         maxChunks: this.levelZeroOnly ? Math.max(this.settings.maxChunks, total) : this.settings.maxChunks,
       },
