@@ -286,3 +286,44 @@ fn etopo5_and_etopo20_keep_every_sample_and_the_extremes_exactly() {
         }
     }
 }
+
+/// The detail noise (up to twice 400 m on steep data) made islands in the Strait of Gibraltar,
+/// whose ETOPO5 cells lie 135 m and more under the sea, and sank land along the coast: the sea a
+/// viewer draws where the ground is below the datum did not follow the data's shoreline. The
+/// detail now fades toward the datum, so it never moves a height across it.
+#[test]
+fn the_detail_noise_made_islands_in_the_strait_of_gibraltar() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/landmarks/coast.cdf");
+    let source = EquirectDem::read_netcdf(&path, None).unwrap();
+    let cube = import(&source, "gibraltar-islands", None);
+    let detail = DetailNoise::default();
+    let (mut land, mut sea, mut moved) = (0, 0, 0);
+    for interp in INTERPS {
+        // a 300 x 120 grid of places over the strait and its coasts, with the detail down to 10 m
+        for y in 0..120 {
+            for x in 0..300 {
+                let lat = 35.6 + 1.2 * f64::from(y) / 119.0;
+                let lon = -6.5 + 2.5 * f64::from(x) / 299.0;
+                let dir = LatLon::new(lat, lon).unwrap().to_unit();
+                let data = cube.height(dir, interp, &DetailNoise::OFF, 10.0);
+                let h = cube.height(dir, interp, &detail, 10.0);
+                assert!(h.is_finite() && data.is_finite(), "({lat}, {lon})");
+                if data > 0.0 {
+                    land += 1;
+                } else {
+                    sea += 1;
+                }
+                if h != data {
+                    moved += 1;
+                }
+                assert!(
+                    (data > 0.0) == (h > 0.0),
+                    "{interp:?} at ({lat:.4}, {lon:.4}): the data give {data:.1} m, the detail makes it {h:.1} m"
+                );
+            }
+        }
+    }
+    // the window holds both, and the detail does move the ground there
+    assert!(land > 5000 && sea > 5000, "land {land}, sea {sea}");
+    assert!(moved > 20_000, "the detail moved {moved} places");
+}

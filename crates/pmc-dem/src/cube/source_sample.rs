@@ -28,6 +28,21 @@ pub(crate) fn sample_fade(fx: f64, fy: f64) -> f64 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// The weight of the detail at a place whose interpolated height is `above` metres above the
+/// datum, where the detail moves heights by at most `bound` metres: `smoothstep(0, 2 bound,
+/// |above|)`. The weighted detail is then smaller in size than `|above|` everywhere
+/// (`bound s(y) < 2 bound y` for `y` in `(0, 1]`), so it never lifts the sea floor above the
+/// datum nor sinks land below it: the shoreline is the interpolated data's 0 m contour, at
+/// every level of detail.
+#[inline]
+pub(crate) fn shore_weight(above: f64, bound: f64) -> f64 {
+    if bound <= 0.0 {
+        return 1.0;
+    }
+    let t = (above.abs() / (2.0 * bound)).min(1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 /// The 4 x 4 source samples round a cell (columns `c0 - 1 ..= c0 + 2`, rows `r0 - 1 ..= r0 + 2`,
 /// at `[row * 4 + column]`; wrapped in longitude for a global grid, clamped onto the edge rows
 /// and columns otherwise) and the relief weights of its four corners.
@@ -184,8 +199,9 @@ impl CubeDem {
 
     /// The interpolated source value at fractions `(fx, fy)` of a cell, and the weight of the
     /// detail there (the corners' relief weights interpolated bilinearly, times
-    /// [`sample_fade`]; 1 when the detail is off). Exact at the corners: the bilinear and the
-    /// Catmull-Rom weights are exactly 1 and 0 there.
+    /// [`sample_fade`] and [`shore_weight`] for a detail of at most `detail_bound` metres; 1
+    /// when the detail is off). Exact at the corners: the bilinear and the Catmull-Rom weights
+    /// are exactly 1 and 0 there.
     #[inline]
     pub(crate) fn source_interpolate(
         &self,
@@ -194,6 +210,7 @@ impl CubeDem {
         fy: f64,
         interp: Interpolation,
         detail_on: bool,
+        detail_bound: f64,
     ) -> (f64, f64) {
         let b = &cell.values;
         let value = match interp {
@@ -218,7 +235,8 @@ impl CubeDem {
         if !detail_on {
             return (value, 1.0);
         }
-        (value, lerp_reliefs(&cell.reliefs, fx, fy) * sample_fade(fx, fy))
+        let shore = shore_weight(value - self.header.datum, detail_bound);
+        (value, lerp_reliefs(&cell.reliefs, fx, fy) * sample_fade(fx, fy) * shore)
     }
 
     /// The interpolated source value in direction `dir` and the detail's weight there.
@@ -227,7 +245,14 @@ impl CubeDem {
             return (f64::NAN, f64::NAN);
         };
         let cell = self.source_cell(place.c0, place.r0, detail);
-        let (value, weight) = self.source_interpolate(&cell, place.fx, place.fy, interp, detail.is_on());
+        let (value, weight) = self.source_interpolate(
+            &cell,
+            place.fx,
+            place.fy,
+            interp,
+            detail.is_on(),
+            detail.bound(self.data_spacing()),
+        );
         self.blend_outside(&place, dir, interp, value, weight)
     }
 
@@ -272,6 +297,7 @@ impl CubeDem {
     ) {
         assert_eq!(points.len(), out.len(), "one output per point");
         let detail_on = detail.is_on();
+        let bound = detail.bound(self.data_spacing());
         let mut cells: Vec<SourceCell> = Vec::new();
         let mut index: HashMap<(u32, u32), usize> = HashMap::new();
         let mut last: Option<((u32, u32), usize)> = None;
@@ -304,7 +330,7 @@ impl CubeDem {
                     i
                 }
             };
-            let (value, weight) = self.source_interpolate(&cells[k], place.fx, place.fy, interp, detail_on);
+            let (value, weight) = self.source_interpolate(&cells[k], place.fx, place.fy, interp, detail_on, bound);
             let (value, weight) = self.blend_outside(&place, dir, interp, value, weight);
             *h = value;
             if detail_on {
