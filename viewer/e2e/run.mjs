@@ -14,6 +14,7 @@
 //                   older than viewer/dist (by default such a binary's API is used behind a small
 //                   front server that serves the fresh viewer/dist)
 //   PMC_E2E_DEM     the elevation model step 11 imports (default: pmc-dem's ETOPO60 fixture)
+//   PMC_E2E_IMAGERY an image step 11 drapes over it (default: none)
 //
 // The harness is harness.mjs (settings, log, clean-ups, steps), servers.mjs (pmc serve, the front
 // server, the mock) and browser.mjs (Chromium, its page and the helpers the steps use); each step

@@ -25,7 +25,16 @@ export async function scenario(t) {
   const dem = join(dir, 'earth.pmcdem');
   const imported = await run(PMC_BIN, ['dem', 'import', source, '-o', dem, '--quiet'], 300_000);
   check(imported.code === 0, `pmc dem import failed: ${imported.out}`);
-  const server = await startBackend(null, { world: join(dir, 'earth.pmcw'), extra: ['--dem', dem] });
+  // PMC_E2E_IMAGERY: an image to drape over it (the README's pictures: NASA's Visible Earth,
+  // /usr/share/xplanet/images/earth.jpg of Debian's xplanet-images)
+  const imagery = [];
+  if (process.env.PMC_E2E_IMAGERY) {
+    const img = join(dir, 'earth.pmcimg');
+    const made = await run(PMC_BIN, ['imagery', 'import', resolve(process.env.PMC_E2E_IMAGERY), '-o', img, '--quiet'], 120_000);
+    check(made.code === 0, `pmc imagery import failed: ${made.out}`);
+    imagery.push('--imagery', img);
+  }
+  const server = await startBackend(null, { world: join(dir, 'earth.pmcw'), extra: ['--dem', dem, ...imagery] });
   // over the East China Sea: China, Korea and Japan, the wide shelf of the Yellow and East
   // China Seas, the deep Philippine Sea
   await page.goto(`${server.url}#mode=orbit&lat=30&lon=127`, { waitUntil: 'load', timeout: 60_000 });
