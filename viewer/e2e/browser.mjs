@@ -26,6 +26,12 @@ export async function openBrowser() {
     'launching Chromium',
   );
   cleanups.push(() => context.close());
+  // The steps run with the atmosphere off (as a user leaves the sky panel's checkbox), since the
+  // software renderer draws the sky and the haze slowly; the sky's step turns it on.
+  // PMC_E2E_SKY=1 leaves it on everywhere (for the README's pictures).
+  if (process.env.PMC_E2E_SKY !== '1') {
+    await context.addInitScript(() => window.localStorage.setItem('pmc.atmosphere', 'off'));
+  }
   const page = context.pages()[0] ?? (await context.newPage());
   page.setDefaultTimeout(60_000);
 

@@ -15,6 +15,8 @@
 //                   front server that serves the fresh viewer/dist)
 //   PMC_E2E_DEM     the elevation model step 11 imports (default: pmc-dem's ETOPO60 fixture)
 //   PMC_E2E_IMAGERY an image step 11 drapes over it (default: none)
+//   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
+//                   on: the software renderer draws it slowly)
 //
 // The harness is harness.mjs (settings, log, clean-ups, steps), servers.mjs (pmc serve, the front
 // server, the mock) and browser.mjs (Chromium, its page and the helpers the steps use); each step

@@ -4,7 +4,7 @@
 
 import * as THREE from 'three';
 import { PmcApi, type PlanetInfo } from './api';
-import type { SkySettings, SkyState } from './atmosphere';
+import { storeAtmosphere, type SkySettings, type SkyState } from './atmosphere';
 import { atmosphereOf } from './atmosphereModel';
 import type { CameraMode } from './cameraModel';
 import { CameraController, type PickResult } from './cameraController';
@@ -554,6 +554,7 @@ export class App implements TestHookTarget {
 
   /** The sky panel's and the test hook's settings: atmosphere on or off, the sun's place. */
   setSky(settings: Partial<SkySettings>): SkyState {
+    if (settings.atmosphere !== undefined) storeAtmosphere(settings.atmosphere);
     this.scene.setSkySettings(settings);
     const state = this.scene.atmosphere.state();
     this.ui.setSky(state);

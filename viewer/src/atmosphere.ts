@@ -233,12 +233,33 @@ export interface SkyState extends SkySettings {
 }
 
 /** The sky: the settings, the uniforms, the full-screen sky mesh. */
+/** Where the sky panel's atmosphere checkbox is remembered between visits (`localStorage`). */
+export const ATMOSPHERE_KEY = 'pmc.atmosphere';
+
+/** The atmosphere checkbox as last left (`'off'` in `localStorage`: off); on by default. */
+export function storedAtmosphere(): boolean {
+  try {
+    return globalThis.localStorage?.getItem(ATMOSPHERE_KEY) !== 'off';
+  } catch {
+    return true;
+  }
+}
+
+/** Remembers the atmosphere checkbox (nothing where storage is unavailable). */
+export function storeAtmosphere(on: boolean): void {
+  try {
+    globalThis.localStorage?.setItem(ATMOSPHERE_KEY, on ? 'on' : 'off');
+  } catch {
+    // private browsing or no storage: the setting lasts for this page only
+  }
+}
+
 export class Atmosphere {
   readonly uniforms = createAtmosphereUniforms();
   readonly sky: THREE.Mesh<THREE.BufferGeometry, THREE.ShaderMaterial>;
   private params: AtmosphereParams | null = null;
   private suppressed = false;
-  private readonly settings: SkySettings = { atmosphere: true, sunAzimuth: DEFAULT_SUN.azimuth, sunElevation: DEFAULT_SUN.elevation };
+  private readonly settings: SkySettings = { atmosphere: storedAtmosphere(), sunAzimuth: DEFAULT_SUN.azimuth, sunElevation: DEFAULT_SUN.elevation };
   private sun: V3 = [0, 1, 0];
   /** The camera of the last frame (planet frame), null before the first. */
   private camera: V3 | null = null;

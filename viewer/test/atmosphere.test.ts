@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { Atmosphere } from '../src/atmosphere';
+import { ATMOSPHERE_KEY, Atmosphere, storeAtmosphere, storedAtmosphere } from '../src/atmosphere';
 import {
   DEFAULT_SUN,
   EARTH_REFERENCE,
@@ -389,5 +389,35 @@ describe('Atmosphere', () => {
     at.frame([0, DATUM - 20, 0]); // below the datum: the shell is entered from just above it
     expect(at.uniforms.uAtmoCamH.value).toBe(1e-3);
     at.dispose();
+  });
+});
+
+describe('the atmosphere checkbox, remembered', () => {
+  it('is on by default, off once left off, and on where storage fails', () => {
+    const store = new Map<string, string>();
+    const fake = { getItem: (k: string) => store.get(k) ?? null, setItem: (k: string, v: string) => void store.set(k, v) };
+    const g = globalThis as { localStorage?: unknown };
+    const saved = g.localStorage;
+    try {
+      g.localStorage = fake;
+      expect(storedAtmosphere()).toBe(true);
+      storeAtmosphere(false);
+      expect(store.get(ATMOSPHERE_KEY)).toBe('off');
+      expect(storedAtmosphere()).toBe(false);
+      storeAtmosphere(true);
+      expect(storedAtmosphere()).toBe(true);
+      g.localStorage = {
+        getItem: () => {
+          throw new Error('no storage');
+        },
+        setItem: () => {
+          throw new Error('no storage');
+        },
+      };
+      expect(storedAtmosphere()).toBe(true);
+      expect(() => storeAtmosphere(false)).not.toThrow();
+    } finally {
+      g.localStorage = saved;
+    }
   });
 });

@@ -45,7 +45,8 @@ export async function scenario(t) {
   });
   await page.waitForFunction(() => window.__pmc !== undefined && window.__pmc.stats().preset === 'earthlike', null, { timeout: 60_000 });
   await ready('the default planet');
-  const sky0 = await hook(() => window.__pmc.sky());
+  // (the other steps run with the atmosphere off: see browser.mjs)
+  const sky0 = await hook(() => window.__pmc.sky({ atmosphere: true }));
   check(sky0.kind === 'earth' && sky0.drawn, `the default planet's sky: ${JSON.stringify(sky0)}`);
 
   /** The ground under (lat, lon): metres above the datum, measured by the fly mode. */
