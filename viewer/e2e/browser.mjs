@@ -30,7 +30,14 @@ export async function openBrowser() {
   // software renderer draws the sky and the haze slowly; the sky's step turns it on.
   // PMC_E2E_SKY=1 leaves it on everywhere (for the README's pictures).
   if (process.env.PMC_E2E_SKY !== '1') {
-    await context.addInitScript(() => window.localStorage.setItem('pmc.atmosphere', 'off'));
+    await context.addInitScript(() => {
+      // (about:blank, between the steps, has no storage)
+      try {
+        window.localStorage.setItem('pmc.atmosphere', 'off');
+      } catch {
+        // nothing to remember there
+      }
+    });
   }
   const page = context.pages()[0] ?? (await context.newPage());
   page.setDefaultTimeout(60_000);
