@@ -46,10 +46,10 @@
 //! next eight entries that count at once ([`crate::noise::gradient3_x8`]): the same bits as one
 //! at a time.
 
-use super::features::{lerp, smoothstep, CaveBand, Scales, Spaghetti, Stretch};
+use super::features::{lerp, radial, smoothstep, CaveBand, Scales, Spaghetti, Stretch};
 use super::layouts::EARTH_RADIUS;
-use super::shading::{Material, Palette};
-use super::{PresetKind, Shade, Shader, Terrain};
+use super::shading::{Look, MaterialMap};
+use super::{PresetKind, Terrain};
 use crate::noise::{
     derive_seed, gradient3, gradient3_x8, mix64, unit_f64, Fbm, FbmParams, Lanes8, DEFAULT_LACUNARITY, LANES,
 };
@@ -58,7 +58,7 @@ use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
 
-/// Material names, indexed by [`Shade::material`].
+/// Material names, indexed by [`super::Shade::material`].
 pub(crate) const MATERIALS: &[&str] = &["seabed", "sand", "grass", "forest", "rock", "snow", "cave"];
 const SEABED: u8 = 0;
 const SAND: u8 = 1;
@@ -699,8 +699,7 @@ pub(crate) struct EarthDensity(pub Arc<EarthModel>);
 impl Density for EarthDensity {
     fn density(&self, p: DVec3) -> f64 {
         let m = &*self.0;
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let (r, dir) = radial(p);
         let mut col = m.column(dir);
         m.refine_for(&mut col, dir, r);
         m.value(&col, dir, r)
@@ -759,13 +758,29 @@ impl Density for EarthDensity {
     }
 }
 
-/// The earth shader: the seabed under water, beaches, deserts in the dry subtropics, grass and
-/// forest below a tree line, rock above it and on steep slopes, snow above a snow line that
+/// The earth's colours.
+const LOOK: Look = Look {
+    names: MATERIALS,
+    colors: &[
+        [[118, 108, 86], [92, 88, 76]],     // seabed
+        [[222, 204, 150], [206, 178, 120]], // sand
+        [[96, 140, 60], [128, 160, 72]],    // grass
+        [[36, 80, 38], [56, 98, 46]],       // forest
+        [[116, 108, 100], [148, 140, 128]], // rock
+        [[244, 246, 252], [216, 224, 238]], // snow
+        [[62, 56, 52], [90, 80, 72]],       // cave
+    ],
+    mix_salt: 70,
+    mix_tiles: 3.0,
+    blend_colors: [[0.36, 0.48, 0.24], [0.58, 0.50, 0.36]],
+};
+
+/// The earth's materials: the seabed under water, beaches, deserts in the dry subtropics, grass
+/// and forest below a tree line, rock above it and on steep slopes, snow above a snow line that
 /// drops from about 5 km at the equator to sea level near the poles, cave rock under the
-/// surface; each material two colours mixed by noise.
-pub(crate) struct EarthShader {
+/// surface.
+pub(crate) struct EarthMaterials {
     model: Arc<EarthModel>,
-    palette: Palette,
     jitter_seed: u64,
     forest_seed: u64,
     dry_seed: u64,
@@ -779,36 +794,22 @@ const TREE_LINE: f64 = 0.72;
 /// Random shift of the snow and tree lines (true-scale metres).
 const LINE_JITTER: f64 = 250.0;
 
-impl EarthShader {
+impl EarthMaterials {
     fn new(model: Arc<EarthModel>, seed: u64) -> Self {
-        let tile = model.s.tile;
-        let palette = Palette::new(
-            derive_seed(seed, 70),
-            vec![
-                Material::srgb([118, 108, 86], [92, 88, 76]),     // seabed
-                Material::srgb([222, 204, 150], [206, 178, 120]), // sand
-                Material::srgb([96, 140, 60], [128, 160, 72]),    // grass
-                Material::srgb([36, 80, 38], [56, 98, 46]),       // forest
-                Material::srgb([116, 108, 100], [148, 140, 128]), // rock
-                Material::srgb([244, 246, 252], [216, 224, 238]), // snow
-                Material::srgb([62, 56, 52], [90, 80, 72]),       // cave
-            ],
-            3.0 * tile,
-        );
-        EarthShader {
+        EarthMaterials {
             model,
-            palette,
             jitter_seed: derive_seed(seed, 71),
             forest_seed: derive_seed(seed, 72),
             dry_seed: derive_seed(seed, 73),
         }
     }
+}
 
+impl MaterialMap for EarthMaterials {
     fn material(&self, p: DVec3, normal: DVec3) -> u8 {
         let m = &*self.model;
         let (l_d, tile, v) = (m.s.l_d, m.s.tile, m.vert);
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let (r, dir) = radial(p);
         let f = m.surface_fields(dir, m.continent(dir));
         // Cave rock: well under the height field. Rock bumps and cliffs move the surface by at
         // most `a_rock + a_cliff`, less than the threshold, so only carved caves get there:
@@ -856,26 +857,13 @@ impl EarthShader {
     }
 }
 
-impl Shader for EarthShader {
-    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material(p, normal), p)
-    }
-    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
-        self.palette.shade_or_unknown(material, p)
-    }
-}
-
 /// Builds the earth terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(EarthModel::new(seed, layout));
-    Terrain {
-        spec: crate::terrain::TerrainSpec::preset(PresetKind::Earth, seed),
-        sea_radius: Some(model.sea()),
-        shader: Arc::new(EarthShader::new(model.clone(), seed)),
-        density: Arc::new(EarthDensity(model)),
-        materials: MATERIALS,
-        blend_colors: [[0.36, 0.48, 0.24], [0.58, 0.50, 0.36]],
-    }
+    let (sea, tile) = (model.sea(), model.s.tile);
+    let density = Arc::new(EarthDensity(model.clone()));
+    let spec = crate::terrain::TerrainSpec::preset(PresetKind::Earth, seed);
+    LOOK.terrain(spec, density, Some(sea), EarthMaterials::new(model, seed), tile)
 }
 
 #[cfg(test)]
@@ -1283,7 +1271,7 @@ mod tests {
         // The shader refines a column only until the comparison with the cave depth is settled:
         // the answer is that of the full ladder, and columns without caves are never cave rock.
         let (_, m, _) = earth(7);
-        let shader = EarthShader::new(m.clone(), 7);
+        let materials = EarthMaterials::new(m.clone(), 7);
         let (mut caves, mut plain) = (0, 0);
         for dir in sphere_dirs(3000) {
             let (c, h) = full(&m, dir);
@@ -1293,7 +1281,7 @@ mod tests {
             let depth = (1.5 * m.s.l_d).max(c.a_rock + c.a_cliff + m.s.l_d);
             for dz in [-60.0, -20.0, -8.0, -3.0, -depth - 0.01, -depth + 0.01, -1.0, 0.0, 2.0] {
                 let r = h + dz;
-                let cave = shader.material(dir * r, dir) == CAVE;
+                let cave = materials.material(dir * r, dir) == CAVE;
                 assert_eq!(
                     cave,
                     c.cave_gate > 0.0 && h - r > depth,

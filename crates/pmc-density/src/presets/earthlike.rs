@@ -15,18 +15,18 @@
 //! | overhangs          | displacement up to 4 `l_d` (at most 0.065 T), on steep mountain slopes | 3 tiles across, 3 `l_d` deep |
 //! | caves              | band from sea level + `l_d` to 2.5 `l_d` under the surface, at most 0.14 T deep; the roof opens in places (cave mouths) | tubes about 2 tiles wide and 3 `l_d` tall, about 12 tiles apart |
 
-use super::features::{
-    carved_voxels, lerp, model_key, smoothstep, CaveBand, ColumnDensity, ColumnModel, NoiseBatch, Overhang, Scales,
-    Spaghetti,
+use super::features::{carved_voxels, lerp, smoothstep, CaveBand, ColumnModel, Overhang, Scales, Spaghetti};
+use super::material::{
+    column_terrain, Bands, Cap, CapLine, CaveRock, Cover, Ground, GroundModel, MaterialRules, SteepRock, VertexColumns,
 };
-use super::shading::{Material, Palette};
-use super::{EdgeVertices, PresetKind, Shade, Shader, Terrain};
+use super::shading::Look;
+use super::{PresetKind, Terrain};
 use crate::noise::{derive_seed, gradient3, gradient3_accumulate, Fbm, FbmParams, Ridged, RidgedParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
 
-/// Material names, indexed by [`Shade::material`].
+/// Material names, indexed by [`super::Shade::material`].
 pub(crate) const MATERIALS: &[&str] = &["sand", "grass", "forest", "rock", "snow", "cave"];
 const SAND: u8 = 0;
 const GRASS: u8 = 1;
@@ -319,245 +319,101 @@ impl ColumnModel for EarthModel {
     }
 }
 
-/// The earthlike shader: height bands (sea-floor sand, beach, grass and forest, rock, snow above
-/// a line that drops toward the poles), rock on steep slopes, cave rock under the surface, each
-/// material two colours mixed by noise.
-pub(crate) struct EarthShader {
-    model: Arc<EarthModel>,
-    palette: Palette,
-    jitter_seed: u64,
-    forest_seed: u64,
-}
-
-impl EarthShader {
-    fn new(model: Arc<EarthModel>, seed: u64) -> Self {
-        let tile = model.s.tile;
-        let palette = Palette::new(
-            derive_seed(seed, 30),
-            vec![
-                Material::srgb([222, 204, 150], [196, 176, 124]), // sand
-                Material::srgb([92, 138, 58], [124, 158, 70]),    // grass
-                Material::srgb([38, 84, 36], [58, 100, 44]),      // forest
-                Material::srgb([112, 106, 98], [146, 138, 126]),  // rock
-                Material::srgb([244, 246, 252], [218, 226, 240]), // snow
-                Material::srgb([62, 56, 52], [90, 80, 72]),       // cave
-            ],
-            1.5 * tile,
-        );
-        EarthShader {
-            model,
-            palette,
-            jitter_seed: derive_seed(seed, 31),
-            forest_seed: derive_seed(seed, 32),
-        }
+impl GroundModel for EarthModel {
+    fn scales(&self) -> &Scales {
+        &self.s
     }
 
-    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
-        let (r, dir) = radial(p);
-        let jitter = || gradient3(self.jitter_point(p), self.jitter_seed);
-        let forest = || gradient3(self.forest_point(dir), self.forest_seed);
-        self.material_in(&(&self.model.column(dir)).into(), r, dir, normal, jitter, forest)
+    /// The sea level.
+    fn datum(&self) -> f64 {
+        self.sea
     }
 
-    /// Where the forest noise is sampled along `dir`.
-    #[inline]
-    fn forest_point(&self, dir: DVec3) -> DVec3 {
-        dir * self.model.s.freq(8.0 * self.model.s.tile)
-    }
-
-    /// Where the jitter of the height bands samples its noise.
-    #[inline]
-    fn jitter_point(&self, p: DVec3) -> DVec3 {
-        p / (2.0 * self.model.s.tile)
-    }
-
-    /// The material at `r` along `dir` in column `col`, with the height bands' jitter noise
-    /// (read only outside caves).
-    #[allow(clippy::too_many_arguments)]
-    fn material_in(
-        &self,
-        col: &ShadeColumn,
-        r: f64,
-        dir: DVec3,
-        normal: DVec3,
-        jitter: impl FnOnce() -> f64,
-        forest: impl FnOnce() -> f64,
-    ) -> u8 {
-        let m = &*self.model;
-        let (t, l_d) = (m.s.thickness, m.s.l_d);
-        if col.h - r > (1.5 * l_d).max(col.amp + l_d) {
-            return CAVE;
-        }
-        let up = normal.dot(dir);
-        let z = r - m.sea + 0.012 * t * jitter();
-        let snow_line = t * (0.25 - 0.32 * dir.y * dir.y);
-        if z > snow_line.max(0.004 * t) && up > 0.5 {
-            SNOW
-        } else if up < 0.62 {
-            ROCK
-        } else if z < 0.012 * t {
-            SAND
-        } else if z < 0.10 * t {
-            if forest() > 0.05 {
-                FOREST
-            } else {
-                GRASS
-            }
-        } else if z < 0.18 * t && !(col.mountains > 0.6 && z > 0.13 * t) {
-            FOREST
-        } else {
-            ROCK
+    /// The mountain mask is the roughness; no feature field.
+    fn ground(col: &EarthColumn) -> Ground {
+        Ground {
+            h: col.h,
+            amp: col.amp,
+            feature: 0.0,
+            rough: col.mountains,
         }
     }
 }
 
-/// What the shader reads of a column.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct ShadeColumn {
-    /// Surface radius of the height field.
-    h: f64,
-    /// Overhang displacement amplitude.
-    amp: f64,
-    /// Mountain mask.
-    mountains: f64,
-}
+/// The earthlike colours.
+const LOOK: Look = Look {
+    names: MATERIALS,
+    colors: &[
+        [[222, 204, 150], [196, 176, 124]], // sand
+        [[92, 138, 58], [124, 158, 70]],    // grass
+        [[38, 84, 36], [58, 100, 44]],      // forest
+        [[112, 106, 98], [146, 138, 126]],  // rock
+        [[244, 246, 252], [218, 226, 240]], // snow
+        [[62, 56, 52], [90, 80, 72]],       // cave
+    ],
+    mix_salt: 30,
+    mix_tiles: 1.5,
+    blend_colors: [[0.42, 0.50, 0.26], [0.56, 0.47, 0.32]],
+};
 
-impl From<&EarthColumn> for ShadeColumn {
-    fn from(c: &EarthColumn) -> Self {
-        ShadeColumn {
-            h: c.h,
-            amp: c.amp,
-            mountains: c.mountains,
-        }
-    }
-}
-
-impl ShadeColumn {
-    /// The column a fraction `t` of the way to `other`, every value interpolated.
-    fn lerp(&self, other: &ShadeColumn, t: f64) -> ShadeColumn {
-        ShadeColumn {
-            h: lerp(self.h, other.h, t),
-            amp: lerp(self.amp, other.amp, t),
-            mountains: lerp(self.mountains, other.mountains, t),
-        }
-    }
-}
-
-impl EarthShader {
-    /// The shades at `points` (normals `normals`) in columns `cols`: the material from the height
-    /// bands and the slope, the colour mixed by the palette's noise; every noise over all the
-    /// points at once.
-    fn shade_columns(&self, points: &[DVec3], normals: &[DVec3], cols: &[ShadeColumn], out: &mut Vec<Shade>) {
-        let (radii, dirs): (Vec<f64>, Vec<DVec3>) = points.iter().map(|p| radial(*p)).unzip();
-        let mut mix = Vec::with_capacity(points.len());
-        self.palette.mix_many(points, &mut mix);
-        // The jitter noise at every point (`0 + 1 n`: a negative zero becomes a positive one,
-        // which leaves `z` unchanged).
-        let mut noise = NoiseBatch::default();
-        noise.set_points(points.len(), |i| self.jitter_point(points[i]));
-        let mut jitter = Vec::new();
-        noise.values(self.jitter_seed, &mut jitter);
-        // The forest noise everywhere (only compared with a positive threshold).
-        noise.set_points(dirs.len(), |i| self.forest_point(dirs[i]));
-        let mut forest = Vec::new();
-        noise.values(self.forest_seed, &mut forest);
-        out.clear();
-        out.extend((0..points.len()).map(|i| {
-            let material = self.material_in(&cols[i], radii[i], dirs[i], normals[i], || jitter[i], || forest[i]);
-            self.palette.shade_mixed(material, mix[i])
-        }));
-    }
-}
-
-/// `(|p|, p / |p|)`, with the direction `+y` at the centre.
-#[inline]
-fn radial(p: DVec3) -> (f64, DVec3) {
-    let r = p.length();
-    (r, if r > 0.0 { p / r } else { DVec3::Y })
-}
-
-impl Shader for EarthShader {
-    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material(p, normal), p)
-    }
-
-    /// One batch of columns ([`EarthModel::columns`]) for all the points.
-    fn shade_many(&self, points: &[DVec3], normals: &[DVec3], _on_surface: bool, out: &mut Vec<Shade>) {
-        assert_eq!(points.len(), normals.len(), "one normal per point");
-        let dirs: Vec<DVec3> = points.iter().map(|p| radial(*p).1).collect();
-        let mut cols = Vec::with_capacity(points.len());
-        self.model.columns(&dirs, &mut cols);
-        let cols: Vec<ShadeColumn> = cols.iter().map(ShadeColumn::from).collect();
-        self.shade_columns(points, normals, &cols, out);
-    }
-
-    /// The columns at the chunk's directions (the batch's, or those the edges name, computed
-    /// once each), interpolated across the surface at the vertices of lateral edges.
-    fn shade_edges(&self, v: &EdgeVertices<'_>, out: &mut Vec<Shade>) {
-        v.check();
-        let computed;
-        let kept = v.columns.get::<EarthColumn>(model_key(&self.model), v.dirs);
-        let (cols, slot): (&[EarthColumn], Option<Vec<u32>>) = match kept {
-            Some(cols) => (cols, None),
-            None => {
-                // Only the directions some edge ends at, each once.
-                let mut slot = vec![u32::MAX; v.dirs.len()];
-                let mut used = Vec::new();
-                for e in v.edges {
-                    for d in [e.a, e.b] {
-                        if slot[d as usize] == u32::MAX {
-                            slot[d as usize] = used.len() as u32;
-                            used.push(v.dirs[d as usize]);
-                        }
-                    }
-                }
-                let mut cols = Vec::with_capacity(used.len());
-                self.model.columns(&used, &mut cols);
-                computed = cols;
-                (&computed, Some(slot))
-            }
-        };
-        let col = |d: u32| match &slot {
-            Some(slot) => &cols[slot[d as usize] as usize],
-            None => &cols[d as usize],
-        };
-        let at: Vec<ShadeColumn> = v
-            .edges
-            .iter()
-            .map(|e| {
-                let a = ShadeColumn::from(col(e.a));
-                if e.a == e.b {
-                    a
-                } else {
-                    a.lerp(&ShadeColumn::from(col(e.b)), e.t)
-                }
-            })
-            .collect();
-        self.shade_columns(v.points, v.normals, &at, out);
-    }
-
-    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
-        self.palette.shade_or_unknown(material, p)
-    }
-}
+/// Where the earthlike materials lie: cave rock under the surface, snow above a line that drops
+/// toward the poles, rock on steep slopes, then height bands (sea-floor sand and beaches, grass
+/// and forest, a forest belt bare on high mountains, rock). Vertices read the columns at their
+/// edge's ends, which the density batch keeps.
+const RULES: MaterialRules = MaterialRules {
+    cave: CaveRock {
+        id: CAVE,
+        depth: 1.5,
+        margin: 1.0,
+    },
+    cap: Some(Cap {
+        id: SNOW,
+        flat: 0.5,
+        line: CapLine::SnowLine {
+            equator: 0.25,
+            fall: 0.32,
+            floor: 0.004,
+        },
+    }),
+    steep: SteepRock {
+        id: ROCK,
+        up_below: 0.62,
+        rough_above: None,
+    },
+    feature: None,
+    cover: Cover::Bands(Bands {
+        shore: SAND,
+        shore_below: 0.012,
+        lowland_below: 0.10,
+        woods: FOREST,
+        open: GRASS,
+        woods_above: 0.05,
+        woods_salt: 32,
+        woods_tiles: 8.0,
+        tree_line: 0.18,
+        bare_above: 0.13,
+        bare_rough: 0.6,
+        high: ROCK,
+    }),
+    jitter_salt: 31,
+    jitter_tiles: 2.0,
+    height_jitter: 0.012,
+    vertices: VertexColumns::EdgeEnds,
+};
 
 /// Builds the earthlike terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(EarthModel::new(seed, layout));
-    Terrain {
-        spec: crate::terrain::TerrainSpec::preset(PresetKind::Earthlike, seed),
-        sea_radius: Some(model.sea()),
-        shader: Arc::new(EarthShader::new(model.clone(), seed)),
-        density: Arc::new(ColumnDensity(model)),
-        materials: MATERIALS,
-        blend_colors: [[0.42, 0.50, 0.26], [0.56, 0.47, 0.32]],
-    }
+    let sea = model.sea();
+    column_terrain(PresetKind::Earthlike, seed, model, Some(sea), &LOOK, RULES)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::presets::features::ColumnDensity;
     use crate::presets::testing::*;
+    use crate::presets::EdgeVertices;
     use crate::{Density, ShellColumns};
     use pmc_geometry::VertexEdge;
 

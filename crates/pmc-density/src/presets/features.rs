@@ -65,6 +65,14 @@ impl Scales {
     }
 }
 
+/// `(|p|, p / |p|)`: a point's radius and direction from the planet's centre, the direction
+/// `+y` at the centre itself.
+#[inline]
+pub(crate) fn radial(p: DVec3) -> (f64, DVec3) {
+    let r = p.length();
+    (r, if r > 0.0 { p / r } else { DVec3::Y })
+}
+
 /// A density split into per-direction work (the column) and per-radius work (the voxel).
 pub(crate) trait ColumnModel: Send + Sync + 'static {
     /// What a column computes once for all its radii.
@@ -112,8 +120,7 @@ pub(crate) struct ColumnDensity<M>(pub Arc<M>);
 
 impl<M: ColumnModel> Density for ColumnDensity<M> {
     fn density(&self, p: DVec3) -> f64 {
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let (r, dir) = radial(p);
         let col = self.0.column(dir);
         self.0.voxel(&col, dir, p, r)
     }

@@ -12,15 +12,19 @@
 //! | caves        | band from 2.5 `l_d` to 0.1 T under the surface, mouths in canyon walls | tubes about 2 tiles wide |
 //! | overhangs    | displacement up to 3 `l_d` on canyon walls      | 3 tiles across, 3 `l_d` deep |
 
-use super::features::{carved_voxels, smoothstep, CaveBand, ColumnDensity, ColumnModel, Overhang, Scales, Spaghetti};
-use super::shading::{Material, Palette};
-use super::{PresetKind, Shade, Shader, Terrain};
+use super::features::{carved_voxels, smoothstep, CaveBand, ColumnModel, Overhang, Scales, Spaghetti};
+use super::material::{
+    column_terrain, Cap, CapLine, CaveRock, Cover, Feature, Ground, GroundModel, MaterialRules, SteepRock,
+    VertexColumns,
+};
+use super::shading::Look;
+use super::{PresetKind, Terrain};
 use crate::noise::{derive_seed, gradient3, mix64, unit_f64, Fbm, FbmParams, Ridged, RidgedParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
 
-/// Material names, indexed by [`Shade::material`].
+/// Material names, indexed by [`super::Shade::material`].
 pub(crate) const MATERIALS: &[&str] = &["dust", "rock", "sand", "ice", "cave"];
 const DUST: u8 = 0;
 const ROCK: u8 = 1;
@@ -259,81 +263,84 @@ impl ColumnModel for MarsModel {
     }
 }
 
-/// The Mars shader: rust dust, darker rock on slopes and canyon floors, dark dune sand, white
-/// polar ice, cave rock.
-pub(crate) struct MarsShader {
-    model: Arc<MarsModel>,
-    palette: Palette,
-    jitter_seed: u64,
-}
-
-impl MarsShader {
-    fn new(model: Arc<MarsModel>, seed: u64) -> Self {
-        let tile = model.s.tile;
-        let palette = Palette::new(
-            derive_seed(seed, 90),
-            vec![
-                Material::srgb([196, 108, 66], [168, 86, 52]),    // dust
-                Material::srgb([118, 70, 52], [150, 94, 66]),     // rock
-                Material::srgb([108, 62, 46], [132, 78, 54]),     // sand
-                Material::srgb([238, 238, 242], [212, 216, 226]), // ice
-                Material::srgb([60, 38, 30], [86, 56, 42]),       // cave
-            ],
-            1.5 * tile,
-        );
-        MarsShader {
-            model,
-            palette,
-            jitter_seed: derive_seed(seed, 91),
-        }
+impl GroundModel for MarsModel {
+    fn scales(&self) -> &Scales {
+        &self.s
     }
 
-    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
-        let m = &*self.model;
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
-        let col = m.column(dir);
-        let up = normal.dot(dir);
-        let jitter = gradient3(p / (3.0 * m.s.tile), self.jitter_seed);
-        if col.h - r > (2.0 * m.s.l_d).max(col.amp + m.s.l_d) {
-            CAVE
-        } else if dir.y.abs() + 0.03 * jitter > ICE_START - 0.03 && up > 0.5 {
-            ICE
-        } else if up < 0.7 || col.canyon > 0.6 {
-            ROCK
-        } else if col.dunes + 0.3 * jitter > 0.5 {
-            SAND
-        } else {
-            DUST
+    fn datum(&self) -> f64 {
+        self.datum
+    }
+
+    /// The dunes are the feature field, the canyons the roughness.
+    fn ground(col: &MarsColumn) -> Ground {
+        Ground {
+            h: col.h,
+            amp: col.amp,
+            feature: col.dunes,
+            rough: col.canyon,
         }
     }
 }
 
-impl Shader for MarsShader {
-    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material(p, normal), p)
-    }
-    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
-        self.palette.shade_or_unknown(material, p)
-    }
-}
+/// Mars's colours: rust dust, darker rock, dark dune sand, white ice, cave rock.
+const LOOK: Look = Look {
+    names: MATERIALS,
+    colors: &[
+        [[196, 108, 66], [168, 86, 52]],    // dust
+        [[118, 70, 52], [150, 94, 66]],     // rock
+        [[108, 62, 46], [132, 78, 54]],     // sand
+        [[238, 238, 242], [212, 216, 226]], // ice
+        [[60, 38, 30], [86, 56, 42]],       // cave
+    ],
+    mix_salt: 90,
+    mix_tiles: 1.5,
+    blend_colors: [[0.62, 0.27, 0.12], [0.44, 0.20, 0.13]],
+};
+
+/// Where Mars's materials lie: cave rock under the surface, polar ice on flat ground, rock on
+/// slopes and canyon floors, sand on the dune fields, dust elsewhere.
+const RULES: MaterialRules = MaterialRules {
+    cave: CaveRock {
+        id: CAVE,
+        depth: 2.0,
+        margin: 1.0,
+    },
+    cap: Some(Cap {
+        id: ICE,
+        flat: 0.5,
+        line: CapLine::Polar {
+            from: ICE_START - 0.03,
+            jitter: 0.03,
+        },
+    }),
+    steep: SteepRock {
+        id: ROCK,
+        up_below: 0.7,
+        rough_above: Some(0.6),
+    },
+    feature: Some(Feature {
+        id: SAND,
+        above: 0.5,
+        jitter: 0.3,
+    }),
+    cover: Cover::Bare(DUST),
+    jitter_salt: 91,
+    jitter_tiles: 3.0,
+    height_jitter: 0.0,
+    vertices: VertexColumns::Own,
+};
 
 /// Builds the Mars terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(MarsModel::new(seed, layout));
-    Terrain {
-        spec: crate::terrain::TerrainSpec::preset(PresetKind::Mars, seed),
-        sea_radius: None,
-        shader: Arc::new(MarsShader::new(model.clone(), seed)),
-        density: Arc::new(ColumnDensity(model)),
-        materials: MATERIALS,
-        blend_colors: [[0.62, 0.27, 0.12], [0.44, 0.20, 0.13]],
-    }
+    column_terrain(PresetKind::Mars, seed, model, None, &LOOK, RULES)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::presets::features::ColumnDensity;
     use crate::presets::testing::*;
     use crate::Density;
 

@@ -6,6 +6,7 @@ mod earthlike;
 pub(crate) mod features;
 mod layouts;
 mod mars;
+mod material;
 mod moon;
 pub(crate) mod shading;
 mod sphere;
@@ -303,6 +304,24 @@ mod tests {
             assert_eq!(colors.len(), t.materials.len(), "{kind}: one colour per material");
             let past = t.shader.shade_material(t.materials.len() as u8, p);
             assert_eq!(past.color, [128, 128, 128, 255], "{kind}: unknown ids are grey");
+        }
+    }
+
+    /// Each preset's shades for a fixed seed, bit for bit: a change here changes how every
+    /// planet of that preset looks, and must be deliberate.
+    #[test]
+    fn preset_shades_golden() {
+        let want = [
+            (PresetKind::Sphere, 0xa356_ba77_c009_f9b1),
+            (PresetKind::Earthlike, 0xdfdb_6711_945a_8599),
+            (PresetKind::Moon, 0x82d2_381b_53cd_bce5),
+            (PresetKind::Mars, 0x45f1_f814_fedb_1295),
+            (PresetKind::Earth, 0x565b_bcc7_298f_2aac),
+        ];
+        for (kind, digest) in want {
+            let layout = kind.default_layout(None).unwrap();
+            let got = testing::shade_digest(&build(kind, 42, &layout), &layout);
+            assert_eq!(got, digest, "{kind}: digest now {got:#x}");
         }
     }
 

@@ -8,15 +8,18 @@
 //! | lava tubes | band from 3 `l_d` to 0.1 T under the maria, skylights where the roof opens | tubes about 2.5 tiles wide |
 
 use super::craters::CraterLevel;
-use super::features::{carved_voxels, smoothstep, CaveBand, ColumnDensity, ColumnModel, Scales, Spaghetti};
-use super::shading::{Material, Palette};
-use super::{PresetKind, Shade, Shader, Terrain};
+use super::features::{carved_voxels, smoothstep, CaveBand, ColumnModel, Scales, Spaghetti};
+use super::material::{
+    column_terrain, CaveRock, Cover, Feature, Ground, GroundModel, MaterialRules, SteepRock, VertexColumns,
+};
+use super::shading::Look;
+use super::{PresetKind, Terrain};
 use crate::noise::{derive_seed, gradient3, Fbm, FbmParams};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
 
-/// Material names, indexed by [`Shade::material`].
+/// Material names, indexed by [`super::Shade::material`].
 pub(crate) const MATERIALS: &[&str] = &["regolith", "mare", "rock", "cave"];
 const REGOLITH: u8 = 0;
 const MARE: u8 = 1;
@@ -161,75 +164,76 @@ impl ColumnModel for MoonModel {
     }
 }
 
-/// The moon shader: light regolith, dark maria, rock on steep crater walls, dark tube walls.
-pub(crate) struct MoonShader {
-    model: Arc<MoonModel>,
-    palette: Palette,
-    jitter_seed: u64,
-}
-
-impl MoonShader {
-    fn new(model: Arc<MoonModel>, seed: u64) -> Self {
-        let tile = model.s.tile;
-        let palette = Palette::new(
-            derive_seed(seed, 60),
-            vec![
-                Material::srgb([172, 170, 164], [140, 139, 134]), // regolith
-                Material::srgb([84, 84, 88], [106, 105, 104]),    // mare
-                Material::srgb([118, 116, 112], [150, 148, 142]), // rock
-                Material::srgb([48, 48, 50], [70, 69, 68]),       // cave
-            ],
-            1.5 * tile,
-        );
-        MoonShader {
-            model,
-            palette,
-            jitter_seed: derive_seed(seed, 61),
-        }
+impl GroundModel for MoonModel {
+    fn scales(&self) -> &Scales {
+        &self.s
     }
 
-    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
-        let m = &*self.model;
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
-        let col = m.column(dir);
-        if col.h - r > 2.0 * m.s.l_d {
-            CAVE
-        } else if normal.dot(dir) < 0.75 {
-            ROCK
-        } else if col.mare + 0.15 * gradient3(p / (3.0 * m.s.tile), self.jitter_seed) > 0.5 {
-            MARE
-        } else {
-            REGOLITH
+    fn datum(&self) -> f64 {
+        self.datum
+    }
+
+    /// The maria are the feature field; no overhangs, no roughness.
+    fn ground(col: &MoonColumn) -> Ground {
+        Ground {
+            h: col.h,
+            amp: 0.0,
+            feature: col.mare,
+            rough: 0.0,
         }
     }
 }
 
-impl Shader for MoonShader {
-    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material(p, normal), p)
-    }
-    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
-        self.palette.shade_or_unknown(material, p)
-    }
-}
+/// The moon's greys: light regolith, dark maria, rock, dark tube walls.
+const LOOK: Look = Look {
+    names: MATERIALS,
+    colors: &[
+        [[172, 170, 164], [140, 139, 134]], // regolith
+        [[84, 84, 88], [106, 105, 104]],    // mare
+        [[118, 116, 112], [150, 148, 142]], // rock
+        [[48, 48, 50], [70, 69, 68]],       // cave
+    ],
+    mix_salt: 60,
+    mix_tiles: 1.5,
+    blend_colors: [[0.52, 0.52, 0.52], [0.36, 0.36, 0.40]],
+};
+
+/// Where the moon's materials lie: tube walls under the surface, rock on steep crater walls,
+/// the maria, regolith elsewhere.
+const RULES: MaterialRules = MaterialRules {
+    cave: CaveRock {
+        id: CAVE,
+        depth: 2.0,
+        margin: 1.0,
+    },
+    cap: None,
+    steep: SteepRock {
+        id: ROCK,
+        up_below: 0.75,
+        rough_above: None,
+    },
+    feature: Some(Feature {
+        id: MARE,
+        above: 0.5,
+        jitter: 0.15,
+    }),
+    cover: Cover::Bare(REGOLITH),
+    jitter_salt: 61,
+    jitter_tiles: 3.0,
+    height_jitter: 0.0,
+    vertices: VertexColumns::Own,
+};
 
 /// Builds the moon terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(MoonModel::new(seed, layout));
-    Terrain {
-        spec: crate::terrain::TerrainSpec::preset(PresetKind::Moon, seed),
-        sea_radius: None,
-        shader: Arc::new(MoonShader::new(model.clone(), seed)),
-        density: Arc::new(ColumnDensity(model)),
-        materials: MATERIALS,
-        blend_colors: [[0.52, 0.52, 0.52], [0.36, 0.36, 0.40]],
-    }
+    column_terrain(PresetKind::Moon, seed, model, None, &LOOK, RULES)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::presets::features::ColumnDensity;
     use crate::presets::testing::*;
     use crate::Density;
 

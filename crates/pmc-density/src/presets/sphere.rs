@@ -1,13 +1,13 @@
 //! The sphere preset: an exact ball in the middle of the shell, for checks.
 
-use super::shading::Material;
-use super::{PresetKind, Shade, Shader, Terrain};
+use super::features::Scales;
+use super::shading::{Look, Uniform};
+use super::{PresetKind, Terrain};
 use crate::Sphere;
-use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
 
-/// Material names, indexed by [`Shade::material`].
+/// Material names, indexed by [`super::Shade::material`].
 pub(crate) const MATERIALS: &[&str] = &["stone"];
 
 /// The radius of the sphere preset: mid-shell plus `0.37 l_d`, so the surface never lies exactly
@@ -17,42 +17,27 @@ pub(crate) fn radius(layout: &Layout) -> f64 {
     layout.d_b() + 0.5 * t + 0.37 * layout.l_d()
 }
 
-/// A plain grey shader.
-struct Grey([u8; 4]);
-
-impl Shader for Grey {
-    fn shade(&self, _p: DVec3, _normal: DVec3) -> Shade {
-        Shade {
-            color: self.0,
-            material: 0,
-        }
-    }
-    fn shade_material(&self, material: u8, _p: DVec3) -> Shade {
-        let color = if usize::from(material) < MATERIALS.len() {
-            self.0
-        } else {
-            super::UNKNOWN_MATERIAL_COLOR
-        };
-        Shade { color, material }
-    }
-}
+/// The sphere's colour: one plain grey.
+const LOOK: Look = Look {
+    names: MATERIALS,
+    colors: &[[[150, 150, 146], [150, 150, 146]]],
+    mix_salt: 1,
+    mix_tiles: 1.5,
+    blend_colors: [[0.60, 0.60, 0.60], [0.48, 0.50, 0.56]],
+};
 
 /// Builds the sphere terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
-    Terrain {
-        spec: crate::terrain::TerrainSpec::preset(PresetKind::Sphere, seed),
-        density: Arc::new(Sphere { radius: radius(layout) }),
-        sea_radius: None,
-        shader: Arc::new(Grey(Material::srgb([150, 150, 146], [150, 150, 146]).color(0.0))),
-        materials: MATERIALS,
-        blend_colors: [[0.60, 0.60, 0.60], [0.48, 0.50, 0.56]],
-    }
+    let density = Arc::new(Sphere { radius: radius(layout) });
+    let spec = crate::terrain::TerrainSpec::preset(PresetKind::Sphere, seed);
+    LOOK.terrain(spec, density, None, Uniform(0), Scales::new(layout).tile)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::presets::testing::*;
+    use pmc_geometry::glam::DVec3;
 
     #[test]
     fn sphere_sits_between_layers_with_exact_bounds() {

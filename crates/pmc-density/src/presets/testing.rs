@@ -151,3 +151,130 @@ pub(crate) fn check_seeds_differ(a: &dyn Density, b: &dyn Density, layout: &Layo
         dirs.len()
     );
 }
+
+/// A digest of every way `t`'s shader colours points near its surface: point by point, on the
+/// surface, in batches, a chunk's edge vertices (with and without the columns its density batch
+/// kept) and each material by id. Pins a terrain's look bit for bit.
+pub(crate) fn shade_digest(t: &Terrain, layout: &Layout) -> u64 {
+    use super::{EdgeVertices, Shade};
+    use crate::ShellColumns;
+    use pmc_geometry::VertexEdge;
+    let d = &*t.density;
+    let (lo, hi) = d.radial_bounds().expect("presets have bounds");
+    let l_d = layout.l_d();
+    let dirs = sphere_dirs(1200);
+    // The surface along each direction (the highest solid sample of a batch over the shell,
+    // refined by bisection), and points around it: deep under (caves), on it, above it.
+    let surface = surfaces(d, &dirs, lo, hi);
+    let offsets = [-40.0, -6.0, -2.5, -1.2, -0.3, 0.0, 0.4, 1.5];
+    let mut points = Vec::new();
+    let mut normals = Vec::new();
+    for (i, (dir, h)) in dirs.iter().zip(&surface).enumerate() {
+        for (k, z) in offsets.iter().enumerate() {
+            let tilt = [0.0, 0.4, 0.9, 1.7][(i + k) % 4];
+            points.push(*dir * (h + z * l_d));
+            normals.push((*dir + dir.any_orthonormal_vector() * tilt).normalize());
+        }
+    }
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |s: &Shade| {
+        for b in s.color.iter().chain([&s.material]) {
+            hash = (hash ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3);
+        }
+    };
+    for (p, n) in points.iter().zip(&normals) {
+        eat(&t.shader.shade(*p, *n));
+        eat(&t.shader.shade_on_surface(*p, *n));
+    }
+    let mut out = Vec::new();
+    for on_surface in [false, true] {
+        t.shader.shade_many(&points, &normals, on_surface, &mut out);
+        out.iter().for_each(&mut eat);
+    }
+    // Edge vertices between neighbouring directions of a chunk-like patch at the highest
+    // surface found, around it.
+    let top = (0..dirs.len())
+        .max_by(|a, b| surface[*a].total_cmp(&surface[*b]))
+        .unwrap();
+    let (pdirs, _) = patch(dirs[top], 2.0 * l_d, 24, hi, l_d, 1);
+    let psurf = surfaces(d, &pdirs, lo, hi);
+    let n = pdirs.len() as u32;
+    let edges: Vec<VertexEdge> = (0..n)
+        .flat_map(|i| {
+            [
+                VertexEdge { a: i, b: i, t: 0.3 },
+                VertexEdge {
+                    a: i,
+                    b: (i + 1) % n,
+                    t: f64::from(i % 7) / 6.0,
+                },
+                VertexEdge {
+                    a: i,
+                    b: (i + 24) % n,
+                    t: 0.5,
+                },
+            ]
+        })
+        .collect();
+    let epoints: Vec<DVec3> = edges
+        .iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let (a, b) = (pdirs[e.a as usize], pdirs[e.b as usize]);
+            let h = psurf[e.a as usize] + (psurf[e.b as usize] - psurf[e.a as usize]) * e.t;
+            (a + (b - a) * e.t).normalize() * (h + offsets[k % offsets.len()] * l_d)
+        })
+        .collect();
+    let enormals: Vec<DVec3> = epoints
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (p.normalize() + DVec3::X * [0.0, 0.5, 1.2][k % 3]).normalize())
+        .collect();
+    let radii: Vec<f64> = (0..4).map(|k| lo + (hi - lo) * f64::from(k) / 3.0).collect();
+    let mut kept = ShellColumns::default();
+    let mut values = vec![0.0f32; pdirs.len() * radii.len()];
+    d.sample_shell_keeping(&pdirs, &radii, &mut values, &mut kept);
+    for columns in [&kept, &ShellColumns::default()] {
+        let v = EdgeVertices {
+            points: &epoints,
+            normals: &enormals,
+            edges: &edges,
+            dirs: &pdirs,
+            columns,
+        };
+        t.shader.shade_edges(&v, &mut out);
+        out.iter().for_each(&mut eat);
+    }
+    for id in 0..=t.materials.len() as u8 {
+        for p in points.iter().step_by(97) {
+            eat(&t.shader.shade_material(id, *p));
+        }
+    }
+    hash
+}
+
+/// Along each of `dirs`, a radius between `lo` and `hi` where the density changes sign (the
+/// highest such change a batch of 256 radii finds, refined by bisection; `lo` where none).
+fn surfaces(d: &dyn Density, dirs: &[DVec3], lo: f64, hi: f64) -> Vec<f64> {
+    let radii: Vec<f64> = (0..256).map(|k| lo + (hi - lo) * f64::from(k) / 255.0).collect();
+    let mut v = vec![0.0f32; dirs.len() * radii.len()];
+    d.sample_shell(dirs, &radii, &mut v);
+    dirs.iter()
+        .enumerate()
+        .map(|(i, dir)| {
+            let Some(k) = (0..radii.len()).rev().find(|k| v[k * dirs.len() + i] > 0.0) else {
+                return lo;
+            };
+            let (mut a, mut b) = (radii[k], radii[(k + 1).min(radii.len() - 1)]);
+            for _ in 0..30 {
+                let m = 0.5 * (a + b);
+                if d.density(*dir * m) > 0.0 {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            a
+        })
+        .collect()
+}

@@ -3,9 +3,9 @@
 
 use super::spec::TerrainSpec;
 use crate::noise::{derive_seed, gradient3};
-use crate::presets::features::{smoothstep, ColumnDensity, ColumnModel, Scales, Spaghetti, Stretch};
-use crate::presets::shading::{Material, Palette};
-use crate::presets::{Shade, Shader, Terrain};
+use crate::presets::features::{radial, smoothstep, ColumnDensity, ColumnModel, Scales, Spaghetti, Stretch};
+use crate::presets::shading::{Look, MaterialMap};
+use crate::presets::Terrain;
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -22,7 +22,7 @@ pub trait HeightField: Send + Sync {
     fn bounds(&self) -> (f64, f64);
 }
 
-/// Material names of height-field terrains, indexed by [`Shade::material`].
+/// Material names of height-field terrains, indexed by [`crate::presets::Shade::material`].
 pub const HEIGHTFIELD_MATERIALS: &[&str] = &[
     "deep seabed",
     "shelf",
@@ -230,28 +230,38 @@ impl ColumnModel for Model {
     }
 }
 
-/// Colours by height above the sea: deep seabed, shelf, sand on the shore, grass and forest, rock
-/// on steep slopes and high up, snow above a snow line falling towards the poles, cave rock
-/// under the surface; each material two colours mixed by noise.
-struct HeightShader {
+/// The height-field terrains' colours.
+const LOOK: Look = Look {
+    names: HEIGHTFIELD_MATERIALS,
+    colors: &[
+        [[46, 62, 92], [58, 70, 96]],       // deep seabed
+        [[96, 120, 118], [120, 128, 110]],  // shelf
+        [[222, 204, 150], [206, 178, 120]], // sand
+        [[96, 140, 60], [128, 160, 72]],    // grass
+        [[36, 80, 38], [56, 98, 46]],       // forest
+        [[116, 108, 100], [148, 140, 128]], // rock
+        [[244, 246, 252], [216, 224, 238]], // snow
+        [[62, 56, 52], [90, 80, 72]],       // cave
+    ],
+    mix_salt: 170,
+    mix_tiles: 3.0,
+    blend_colors: [[0.36, 0.48, 0.24], [0.62, 0.52, 0.34]],
+};
+
+/// Materials by height above the sea: deep seabed, shelf, sand on the shore, grass and forest,
+/// rock on steep slopes and high up, snow above a snow line falling towards the poles, cave rock
+/// under the surface.
+struct HeightMaterials {
     model: Arc<Model>,
-    palette: Palette,
     forest_seed: u64,
     jitter_seed: u64,
 }
 
-impl HeightShader {
-    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
-        self.material_under(p, normal, self.model.surface(dir))
-    }
-
+impl HeightMaterials {
     /// The material at `p` under (or on) the surface of radius `h` above it.
     fn material_under(&self, p: DVec3, normal: DVec3, h: f64) -> u8 {
         let m = &*self.model;
-        let r = p.length();
-        let dir = if r > 0.0 { p / r } else { DVec3::Y };
+        let (r, dir) = radial(p);
         let l_d = m.s.l_d;
         if r < h - 1.5 * l_d - m.rock_amp {
             return CAVE;
@@ -289,17 +299,15 @@ impl HeightShader {
     }
 }
 
-impl Shader for HeightShader {
-    fn shade(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material(p, normal), p)
+impl MaterialMap for HeightMaterials {
+    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+        self.material_under(p, normal, self.model.surface(radial(p).1))
     }
+
     /// The surface is `p` itself: no height lookup (a lookup is most of a height-field patch's
     /// cost).
-    fn shade_on_surface(&self, p: DVec3, normal: DVec3) -> Shade {
-        self.palette.shade(self.material_under(p, normal, p.length()), p)
-    }
-    fn shade_material(&self, material: u8, p: DVec3) -> Shade {
-        self.palette.shade_or_unknown(material, p)
+    fn material_on_surface(&self, p: DVec3, normal: DVec3) -> u8 {
+        self.material_under(p, normal, p.length())
     }
 }
 
@@ -319,34 +327,13 @@ pub fn heightfield_terrain(
 ) -> Result<Terrain, ReliefError> {
     let seed = spec.seed();
     let model = Arc::new(Model::new(field, seed, layout, vertical_scale)?);
-    let palette = Palette::new(
-        derive_seed(seed, 170),
-        vec![
-            Material::srgb([46, 62, 92], [58, 70, 96]),       // deep seabed
-            Material::srgb([96, 120, 118], [120, 128, 110]),  // shelf
-            Material::srgb([222, 204, 150], [206, 178, 120]), // sand
-            Material::srgb([96, 140, 60], [128, 160, 72]),    // grass
-            Material::srgb([36, 80, 38], [56, 98, 46]),       // forest
-            Material::srgb([116, 108, 100], [148, 140, 128]), // rock
-            Material::srgb([244, 246, 252], [216, 224, 238]), // snow
-            Material::srgb([62, 56, 52], [90, 80, 72]),       // cave
-        ],
-        3.0 * model.s.tile,
-    );
-    let shader = HeightShader {
+    let map = HeightMaterials {
         model: model.clone(),
-        palette,
         forest_seed: derive_seed(seed, 171),
         jitter_seed: derive_seed(seed, 172),
     };
-    Ok(Terrain {
-        spec,
-        sea_radius: Some(model.sea),
-        shader: Arc::new(shader),
-        density: Arc::new(ColumnDensity(model)),
-        materials: HEIGHTFIELD_MATERIALS,
-        blend_colors: [[0.36, 0.48, 0.24], [0.62, 0.52, 0.34]],
-    })
+    let (sea, tile) = (model.sea, model.s.tile);
+    Ok(LOOK.terrain(spec, Arc::new(ColumnDensity(model)), Some(sea), map, tile))
 }
 
 #[cfg(test)]
@@ -377,6 +364,16 @@ mod tests {
 
     fn earth_layout() -> Layout {
         crate::presets::layout_for_radius(crate::presets::EARTH_RADIUS).unwrap()
+    }
+
+    /// The shades of a fixed field and seed, bit for bit: a change here changes how every
+    /// elevation model looks, and must be deliberate.
+    #[test]
+    fn heightfield_shades_golden() {
+        let layout = earth_layout();
+        let t = heightfield_terrain(Arc::new(Analytic), spec(), &layout, 1.0).unwrap();
+        let got = crate::presets::testing::shade_digest(&t, &layout);
+        assert_eq!(got, 0x4166_1241_6f86_3073, "digest now {got:#x}");
     }
 
     #[test]
