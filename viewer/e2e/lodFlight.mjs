@@ -187,9 +187,19 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
   check(first.panel !== last.panel, `${label}: the panel's histogram did not change (${first.panel})`);
 
   if (jitter) {
-    // a still camera at the last stop: two pictures some frames apart, identical
+    // a still camera at the last stop: two pictures some frames apart, the second drawn anew
+    // (a still view is not redrawn unless asked), identical
     const a = await shot(`${label}-still-a`);
     await hook(() => new Promise((r) => setTimeout(r, 500)));
+    await hook(
+      () =>
+        new Promise((resolve) => {
+          const d0 = window.__pmc.stats().draws;
+          window.__pmc.redraw();
+          const poll = () => (window.__pmc.stats().draws > d0 ? resolve() : setTimeout(poll, 20));
+          poll();
+        }),
+    );
     const b = await shot(`${label}-still-b`);
     const s = await hook(() => window.__pmc.stats());
     const planet = await hook(([p, sd]) => fetch(`api/v1/planet?preset=${p}&seed=${sd}`).then((x) => x.json()), [s.preset, s.seed]);

@@ -187,6 +187,7 @@ export class App implements TestHookTarget {
         },
         panels: (planetShown) => this.panels(planetShown),
         moved: () => this.writeHash(false),
+        pictureChanges: () => this.navScene.pictureChanges(),
       },
     );
 
@@ -543,6 +544,11 @@ export class App implements TestHookTarget {
     return this.selection.settings;
   }
 
+  /** The next frame draws, whatever its picture's key (the test hook's `redraw()`). */
+  invalidate(): void {
+    this.loop.invalidate();
+  }
+
   // ---- panels -------------------------------------------------------------------------------
 
   private resize(): void {
@@ -615,6 +621,7 @@ export class App implements TestHookTarget {
       failed: st.failed,
       fps: this.loop.fps,
       frames: this.loop.frames,
+      draws: this.loop.draws,
       lat: cam.state.lat,
       lon: cam.state.lon,
       alt: cam.state.alt,

@@ -10,6 +10,7 @@ import type { ChunkStreamer } from './chunkStreamer';
 import { length, type V3 } from './frames';
 import type { Input, InputFrame } from './input';
 import type { PlanetParams } from './planetParams';
+import { PictureKey } from './pictureKey';
 import type { PlanetScene } from './planetScene';
 import type { Readiness } from './readiness';
 import type { Ui } from './ui';
@@ -45,6 +46,8 @@ export interface FrameSteps {
   panels(planetShown: boolean): void;
   /** The camera moved this frame. */
   moved(): void;
+  /** Changes to the objects the application draws besides the scene's (the navigation overlay). */
+  pictureChanges(): number;
 }
 
 export class FrameLoop {
@@ -55,7 +58,13 @@ export class FrameLoop {
   private fpsFrames = 0;
   private fpsSince = performance.now();
   private lastUiUpdate = 0;
+  /** Frames that drew. */
+  draws = 0;
   private readonly redraw = new RedrawPolicy();
+  /** The key of the last picture drawn (render on demand: see pictureKey.ts). */
+  private readonly pictureKey = new PictureKey();
+  private readonly key: number[] = [];
+  private readonly bufferSize = new THREE.Vector2();
 
   constructor(
     private readonly parts: FrameParts,
@@ -64,6 +73,36 @@ export class FrameLoop {
 
   start(): void {
     this.parts.renderer.setAnimationLoop(() => this.frame());
+  }
+
+  /** The next frame draws, whether or not the picture's key changed. */
+  invalidate(): void {
+    this.pictureKey.invalidate();
+  }
+
+  /** Draws the scene, remembering the key of the picture drawn. */
+  private draw(now: number): void {
+    const { renderer, scene, cameras } = this.parts;
+    renderer.render(scene.scene, cameras.camera);
+    this.redraw.drew(now);
+    this.pictureKey.drew(this.key);
+    this.draws++;
+  }
+
+  /**
+   * The key of the picture this frame would draw with the camera at `pos` (planet frame): the
+   * camera, the drawing buffer, the scene's key and the application's changes.
+   */
+  private frameKey(pos: readonly number[]): readonly number[] {
+    const { renderer, scene, cameras } = this.parts;
+    const key = this.key;
+    key.length = 0;
+    cameras.camera.updateMatrixWorld();
+    renderer.getDrawingBufferSize(this.bufferSize);
+    key.push(pos[0]!, pos[1]!, pos[2]!, this.bufferSize.x, this.bufferSize.y, this.steps.pictureChanges());
+    key.push(...cameras.camera.matrixWorld.elements, ...cameras.camera.projectionMatrix.elements);
+    scene.pushPictureKey(key);
+    return key;
   }
 
   private frame(): void {
@@ -83,8 +122,7 @@ export class FrameLoop {
     const params = steps.params();
     const input = inputs.take();
     if (!params) {
-      renderer.render(scene.scene, cameras.camera);
-      this.redraw.drew(now);
+      if (this.pictureKey.changed(this.frameKey([0, 0, 0]))) this.draw(now);
       ui.setLoading(0, 0, steps.busy() ?? 'waiting for the server');
       steps.panels(false);
       return;
@@ -114,10 +152,8 @@ export class FrameLoop {
     streamer.update();
 
     const settled = streamer.settled();
-    if (this.redraw.shouldDraw(now, moved || inputActive(input), settled)) {
-      renderer.render(scene.scene, cameras.camera);
-      this.redraw.drew(now);
-    }
+    const changed = this.pictureKey.changed(this.frameKey(pos));
+    if (this.redraw.shouldDraw(now, moved || inputActive(input), settled, changed)) this.draw(now);
 
     const st = streamer.stats();
     readiness.frame(steps.busy() === null && selection.current() && settled);
@@ -161,13 +197,15 @@ function inputActive(input: InputFrame): boolean {
 }
 
 /**
- * Which frames draw. Every frame draws, except on a slow renderer (software WebGL, an old GPU:
- * over SLOW_FRAME_MS a drawn frame) while chunks stream in under a still camera: then the picture
- * is redrawn every STREAMING_REDRAW_MS, or once in STREAMING_DRAW_SHARE frame times when drawing
- * takes longer. A busy GPU holds up what the page sends it (chunk uploads, the compositor's read
- * back of the canvas) until the frame before is done, so redrawing a picture that changes by a
- * few chunks at a time would starve the streaming (by 20 times with software WebGL on two cores).
- * A camera that moves, or input, draws at once; a settled view draws every frame.
+ * Which frames draw. A frame whose picture would be the one drawn last (same camera, same objects,
+ * same uniforms: `changed` false) does not draw. Otherwise every frame draws, except on a slow
+ * renderer (software WebGL, an old GPU: over SLOW_FRAME_MS a drawn frame) while chunks stream in
+ * under a still camera: then the picture is redrawn every STREAMING_REDRAW_MS, or once in
+ * STREAMING_DRAW_SHARE frame times when drawing takes longer. A busy GPU holds up what the page
+ * sends it (chunk uploads, the compositor's read back of the canvas) until the frame before is
+ * done, so redrawing a picture that changes by a few chunks at a time would starve the streaming
+ * (by 20 times with software WebGL on two cores). A camera that moves, or input, draws at once; a
+ * settled view draws as soon as it changed.
  */
 export class RedrawPolicy {
   /** Milliseconds a frame that draws takes (a running mean of the intervals after drawing). */
@@ -181,9 +219,14 @@ export class RedrawPolicy {
     this.drewLast = false;
   }
 
-  /** Whether the frame starting at `now` draws (`active`: the camera moved or input came). */
-  shouldDraw(now: number, active: boolean, settled: boolean): boolean {
-    if (active || settled || this.renderMs < SLOW_FRAME_MS) return true;
+  /**
+   * Whether the frame starting at `now` draws (`active`: the camera moved or input came;
+   * `changed`: its picture differs from the last drawn).
+   */
+  shouldDraw(now: number, active: boolean, settled: boolean, changed = true): boolean {
+    if (active) return true;
+    if (!changed) return false;
+    if (settled || this.renderMs < SLOW_FRAME_MS) return true;
     return now - this.lastDraw >= Math.max(STREAMING_REDRAW_MS, STREAMING_DRAW_SHARE * this.renderMs);
   }
 

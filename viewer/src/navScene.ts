@@ -34,6 +34,8 @@ interface Placed {
 export class NavScene {
   readonly group = new THREE.Group();
   private readonly placed: Placed[] = [];
+  /** Objects added and removed so far (a part of the picture's key: see pictureKey.ts). */
+  private changes = 0;
 
   private readonly pathMaterial = new LineMaterial({ color: colour(PATH_COLOUR), linewidth: PATH_WIDTH, worldUnits: false });
   private readonly xrayMaterial = new LineMaterial({
@@ -180,6 +182,11 @@ export class NavScene {
     this.grid = { objects, geometries, placed };
   }
 
+  /** Objects added and removed so far: the overlay's part of the picture's key. */
+  pictureChanges(): number {
+    return this.changes;
+  }
+
   /** Whether the grid overlay has something drawn. */
   gridShown(): boolean {
     return this.grid !== null;
@@ -193,12 +200,14 @@ export class NavScene {
   private add(p: Placed): void {
     this.placed.push(p);
     this.group.add(p.object);
+    this.changes++;
   }
 
   private remove(p: Placed): void {
     const i = this.placed.indexOf(p);
     if (i >= 0) this.placed.splice(i, 1);
     this.group.remove(p.object);
+    this.changes++;
   }
 
   /** Floating origin: every object at (its origin - camera), computed in f64. */

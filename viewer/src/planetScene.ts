@@ -11,6 +11,7 @@ import { boundaryEdges } from './boundaryEdges';
 import { modPositive, relativeToCamera, type V3 } from './frames';
 import { imageryCellMetres, type ImageryInfo } from './imagery';
 import { materialUniforms } from './materials';
+import { pushUniform, pushUniforms } from './pictureKey';
 import type { PlanetParams } from './planetParams';
 import { buildSeaDisk, seaDiskStale, type SeaDisk } from './seaGeometry';
 import { seaFragment, seaVertex, terrainFragment, terrainVertex } from './shaders';
@@ -154,6 +155,11 @@ export class PlanetScene {
   });
 
   private readonly background = SPACE_BACKGROUND.clone();
+  /**
+   * Changes to what is drawn that neither the camera nor a uniform shows (objects added, removed,
+   * shown or hidden, materials switched), counted for the picture's key (see `pushPictureKey`).
+   */
+  private changes = 0;
 
   /** The brush cursor: a translucent ball of the brush radius and a ring across it. */
   private readonly cursor = new THREE.Group();
@@ -218,6 +224,24 @@ export class PlanetScene {
     this.background.copy(SPACE_BACKGROUND).lerp(SKY_BACKGROUND, t);
   }
 
+  /**
+   * Pushes onto `out` what the picture of this scene depends on besides the camera: the changes
+   * counted, the background, every shading uniform (the atmosphere's too), the sea's side and the
+   * brush cursor. Two frames with the same key (and the same camera) draw the same picture.
+   */
+  pushPictureKey(out: number[]): void {
+    out.push(this.changes, this.background.r, this.background.g, this.background.b);
+    pushUniforms(out, this.shared);
+    out.push(this.seaMaterial.side, this.sea?.visible ? 1 : 0, this.atmosphere.sky.visible ? 1 : 0);
+    const c = this.cursor;
+    if (c.visible) {
+      out.push(1, ...c.position.toArray(), ...c.scale.toArray(), ...c.quaternion.toArray());
+      pushUniform(out, this.cursorBallMaterial.color);
+    } else {
+      out.push(0);
+    }
+  }
+
   /** The background colour drawn now, as 8-bit sRGB (what a screenshot shows where nothing is drawn). */
   backgroundRgb(): [number, number, number] {
     const c = this.background.clone().convertLinearToSRGB();
@@ -227,6 +251,7 @@ export class PlanetScene {
   /** Sets the planet's shading parameters and rebuilds the sea (chunks are cleared separately). */
   setPlanet(params: PlanetParams): void {
     this.params = params;
+    this.changes++;
     const s = this.shared;
     const m = materialUniforms(params.materials);
     for (let i = 0; i < s.uMatA.value.length; i++) {
@@ -260,6 +285,7 @@ export class PlanetScene {
   }
 
   private removeSea(): void {
+    this.changes++;
     if (this.sea) {
       this.scene.remove(this.sea);
       this.sea.geometry.dispose();
@@ -364,6 +390,7 @@ export class PlanetScene {
     };
     this.chunks.set(key, obj);
     this.terrainGroup.add(mesh);
+    this.changes++;
     if (this.flags.borders) this.addBorders(obj, chunk.indices, chunk.vertexCount);
   }
 
@@ -394,6 +421,7 @@ export class PlanetScene {
     obj.mesh.geometry.dispose();
     obj.mesh.material.dispose();
     this.chunks.delete(key);
+    this.changes++;
   }
 
   clearChunks(): void {
@@ -403,6 +431,7 @@ export class PlanetScene {
   setDebug(flags: Partial<DebugFlags>): void {
     const next = { ...this.flags, ...flags };
     const bordersChanged = next.borders !== this.flags.borders;
+    this.changes++;
     this.flags = next;
     this.shared.uDebugFace.value = next.faceColours ? 1 : 0;
     this.shared.uBackfaceFlag.value = next.backfaces ? 1 : 0;
@@ -461,6 +490,7 @@ export class PlanetScene {
       this.sea.geometry = ng;
       this.seaDisk = disk;
       this.seaBuiltFor = [camera[0], camera[1], camera[2]];
+      this.changes++;
       const below = Math.hypot(camera[0], camera[1], camera[2]) < R;
       this.seaMaterial.side = below ? THREE.BackSide : THREE.FrontSide;
     }

@@ -46,7 +46,9 @@ export interface PmcStats {
   requested: number;
   failed: number;
   fps: number;
+  /** Animation frames so far, and the frames of them that drew (a still, settled view draws nothing). */
   frames: number;
+  draws: number;
   lat: number;
   lon: number;
   alt: number;
@@ -150,6 +152,11 @@ export interface PmcTestHook {
    * returns them.
    */
   lod(settings?: Partial<LodSettings>): LodSettings;
+  /**
+   * Draws the next frame even if its picture's key is the last drawn one (the frame loop draws
+   * only when the picture changes): a still camera's next picture, drawn anew.
+   */
+  redraw(): void;
 }
 
 declare global {
@@ -180,6 +187,8 @@ export interface TestHookTarget {
   setSky(settings: Partial<SkySettings>): SkyState;
   setLod(settings: Partial<LodSettings>): void;
   lodSettings(): LodSettings;
+  /** The next frame draws, whatever its picture's key. */
+  invalidate(): void;
 }
 
 export function createTestHook(app: TestHookTarget): PmcTestHook {
@@ -220,6 +229,7 @@ export function createTestHook(app: TestHookTarget): PmcTestHook {
       if (settings) app.setLod(settings);
       return { ...app.lodSettings() };
     },
+    redraw: () => app.invalidate(),
   };
 }
 

@@ -45,7 +45,16 @@ describe('RedrawPolicy', () => {
     expect(drawn.length).toBeLessThanOrEqual(Math.ceil(5000 / gap));
   });
 
-  it('a moving camera, input or a settled view draws every frame, however slow', () => {
+  it('a frame whose picture is the last drawn does not draw, settled or streaming, fast or slow; input still draws', () => {
+    const p = new RedrawPolicy();
+    p.frameStarted(16);
+    expect(p.shouldDraw(0, false, true, false)).toBe(false);
+    expect(p.shouldDraw(0, false, false, false)).toBe(false);
+    expect(p.shouldDraw(0, false, true, true)).toBe(true);
+    expect(p.shouldDraw(0, true, true, false)).toBe(true);
+  });
+
+  it('a moving camera, input or a settled view that changed draws every frame, however slow', () => {
     const p = new RedrawPolicy();
     p.frameStarted(0);
     p.drew(0);
