@@ -341,7 +341,7 @@ fn import(a: &ImportArgs) -> Result<(), CliError> {
             "digest": report.digest,
             "accuracy": accuracy,
         });
-        println!("{}", serde_json::to_string_pretty(&out).expect("JSON"));
+        outln!("{}", serde_json::to_string_pretty(&out).expect("JSON"));
     }
     if let (Some(img), Some(input)) = (&imagery, &a.imagery) {
         crate::imagery::write_image(img, input, &crate::imagery::beside(&a.output), a.quiet)?;
@@ -388,15 +388,15 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
             "verified": a.verify,
             "levels": rows,
         });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         return Ok(());
     }
-    println!("file         {}", a.file.display());
-    println!("source       {}", dem.source_name());
+    outln!("file         {}", a.file.display());
+    outln!("source       {}", dem.source_name());
     let [west, east, south, north] = dem.source_extent();
-    println!("extent       {west}..{east} E, {south}..{north} N (degrees, sample positions)");
-    println!("body radius  {} m", dem.radius());
-    println!(
+    outln!("extent       {west}..{east} E, {south}..{north} N (degrees, sample positions)");
+    outln!("body radius  {} m", dem.radius());
+    outln!(
         "data level   {} ({} samples a face side), {:?} samples, {} filled",
         dem.data_level(),
         (1u64 << dem.data_level()) + 1,
@@ -404,25 +404,25 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
         dem.filled_samples()
     );
     match dem.source_size() {
-        Some((w, h)) => println!(
+        Some((w, h)) => outln!(
             "source grid  {w} x {h} samples, {} (heights interpolated from it: version {})",
             human(dem.source_bytes()),
             dem.version()
         ),
-        None => println!(
+        None => outln!(
             "source grid  not kept (version {}: heights interpolated from the faces)",
             dem.version()
         ),
     }
-    println!("heights      {lo} m to {hi} m");
-    println!("digest       {}", dem.digest());
+    outln!("heights      {lo} m to {hi} m");
+    outln!("digest       {}", dem.digest());
     if a.verify {
-        println!("verified     every tile's checksum");
+        outln!("verified     every tile's checksum");
     }
-    println!();
-    println!("samples a face side   six faces at 16 bits   in this file   m/sample (face centre)   m/sample (equator)");
+    outln!();
+    outln!("samples a face side   six faces at 16 bits   in this file   m/sample (face centre)   m/sample (equator)");
     for r in &table {
-        println!(
+        outln!(
             "{:>19}  {:>21}  {:>13}  {:>23.2}  {:>19.2}",
             format!("2^{} + 1 = {}", r.log2, r.samples_per_side),
             human(r.bytes_16bit),
@@ -480,22 +480,25 @@ fn probe(a: &ProbeArgs) -> Result<(), CliError> {
             "interpolated": interpolated,
             "meshed": levels.iter().map(|(l, h)| serde_json::json!({"level": l, "height": h})).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         return Ok(());
     }
-    println!("place           {}, {}", a.lat, a.lon);
-    println!(
+    outln!("place           {}, {}", a.lat, a.lon);
+    outln!(
         "DEM sample      {} m (nearest sample at {:.4}, {:.4}, {:.0} m away)",
-        sample.value, sample.lat, sample.lon, sample.distance
+        sample.value,
+        sample.lat,
+        sample.lon,
+        sample.distance
     );
-    println!(
+    outln!(
         "interpolated    {interpolated:.3} m ({}, with detail noise)",
         a.interpolation
     );
     for (level, h) in &levels {
         match h {
-            Some(h) => println!("meshed level {level:>2} {h:.3} m ({:+.3} m)", h - interpolated),
-            None => println!("meshed level {level:>2} no surface met"),
+            Some(h) => outln!("meshed level {level:>2} {h:.3} m ({:+.3} m)", h - interpolated),
+            None => outln!("meshed level {level:>2} no surface met"),
         }
     }
     Ok(())

@@ -110,20 +110,31 @@ pub fn run(args: &FlightArgs) -> Result<(), CliError> {
                 |(name, reports)| json!({"flight": name, "stops": reports.iter().map(report_json).collect::<Vec<_>>()}),
             )
             .collect();
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
     } else {
-        println!(
+        outln!(
             "{} seed {} (radius {:.0} m) at {lat}, {lon}; {} px, 1920x1080, 60 deg",
-            name, args.planet.seed, radius, args.pixels
+            name,
+            args.planet.seed,
+            radius,
+            args.pixels
         );
         for (name, reports) in &all {
-            println!("\n{name}:");
-            println!(
+            outln!("\n{name}:");
+            outln!(
                 "{:>8} {:>12} {:>10} {:>8} {:>7} {:>11} {:>10} {:>8} {:>6}  levels drawn",
-                "stop", "height m", "converged", "select", "chunks", "triangles", "vs L0", "RSS MB", "cores"
+                "stop",
+                "height m",
+                "converged",
+                "select",
+                "chunks",
+                "triangles",
+                "vs L0",
+                "RSS MB",
+                "cores"
             );
             for r in reports {
-                println!(
+                outln!(
                     "{:>8} {:>12.1} {:>9.3}s {:>6.1}ms {:>7} {:>11} {:>9.1e}x {:>8} {:>6}  {}",
                     r.name,
                     r.height,

@@ -130,12 +130,12 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
             "wraps": e.wraps(),
             "digest": img.digest(),
         });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         return Ok(());
     }
-    println!("file     {}", a.file.display());
-    println!("size     {} x {} pixels, 8-bit RGB (sRGB)", img.width(), img.height());
-    println!(
+    outln!("file     {}", a.file.display());
+    outln!("size     {} x {} pixels, 8-bit RGB (sRGB)", img.width(), img.height());
+    outln!(
         "extent   west {}, east {}, south {}, north {} (pixel edges){}",
         e.west(),
         e.east(),
@@ -143,12 +143,12 @@ fn info(a: &InfoArgs) -> Result<(), CliError> {
         e.north(),
         if e.wraps() { ", round the globe" } else { "" }
     );
-    println!(
+    outln!(
         "pixel    {} x {} degrees",
         e.lon_span() / f64::from(img.width()),
         e.lat_span() / f64::from(img.height())
     );
-    println!("digest   {}", img.digest());
+    outln!("digest   {}", img.digest());
     Ok(())
 }
 
@@ -157,12 +157,12 @@ fn probe(a: &ProbeArgs) -> Result<(), CliError> {
     let color = img.color_at(a.lat, a.lon);
     if a.json {
         let v = serde_json::json!({ "lat": a.lat, "lon": a.lon, "rgb": color });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         return Ok(());
     }
     match color {
-        Some([r, g, b]) => println!("{r} {g} {b}"),
-        None => println!("outside the image (extent {})", img.extent()),
+        Some([r, g, b]) => outln!("{r} {g} {b}"),
+        None => outln!("outside the image (extent {})", img.extent()),
     }
     Ok(())
 }

@@ -58,10 +58,10 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
                 "chunk_deep": v.chunk_deep,
             })).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&v).expect("JSON of plain values"));
+        outln!("{}", serde_json::to_string_pretty(&v).expect("JSON of plain values"));
         return Ok(());
     }
-    println!(
+    outln!(
         "planet       {} ({}), seed {}",
         t.spec.name(),
         t.spec
@@ -69,7 +69,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             .map_or("an elevation model, detail noise and caves", |k| k.description()),
         t.spec.seed()
     );
-    println!(
+    outln!(
         "layout       n_c = {}, n_t = {}, d_b = {} m, l_d = {} m, d_c = {}",
         l.n_c(),
         l.n_t(),
@@ -77,14 +77,14 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         l.l_d(),
         l.d_c()
     );
-    println!("chunks       {} (Eq. 2: 6 n_c^2 d_c)", l.chunk_count());
-    println!(
+    outln!("chunks       {} (Eq. 2: 6 n_c^2 d_c)", l.chunk_count());
+    outln!(
         "voxels       {} (Eq. 3: 6 (n_t n_c + 1)^2 (n_t d_c + 1)), {} once paired",
         l.voxel_count(),
         l.unique_voxel_count()
     );
-    println!("radius       {} m (Eq. 4: d_b + l_d n_t d_c)", l.radius());
-    println!(
+    outln!("radius       {} m (Eq. 4: d_b + l_d n_t d_c)", l.radius());
+    outln!(
         "grid         {} tiles per face side, {} deep; tiles about {:.2} m wide at the surface, {} m deep",
         l.face_tiles(),
         l.depth_tiles(),
@@ -92,28 +92,28 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         l.l_d()
     );
     match t.sea_radius {
-        Some(s) => println!("sea          radius {s:.2} m ({:.2} m above the base)", s - l.d_b()),
-        None => println!("sea          none"),
+        Some(s) => outln!("sea          radius {s:.2} m ({:.2} m above the base)", s - l.d_b()),
+        None => outln!("sea          none"),
     }
     if let Some((a, b)) = bounds {
         match candidate {
-            Some(c) => println!(
+            Some(c) => outln!(
                 "surface      between radius {a:.2} and {b:.2} m; {c} of {} chunks may hold it",
                 l.chunk_count()
             ),
-            None => println!("surface      between radius {a:.2} and {b:.2} m"),
+            None => outln!("surface      between radius {a:.2} and {b:.2} m"),
         }
     }
-    println!("materials    {}", t.materials.join(", "));
-    println!(
+    outln!("materials    {}", t.materials.join(", "));
+    outln!(
         "levels       {} levels of detail, 0 to {}; voxel widths across the face (min-max) at radius {} m",
         levels.len(),
         l.max_level(),
         l.radius()
     );
-    println!("  level  chunks/side  depth chunks  voxel across (min-max)  voxel radial  chunk (across x deep)");
+    outln!("  level  chunks/side  depth chunks  voxel across (min-max)  voxel radial  chunk (across x deep)");
     for v in &levels {
-        println!(
+        outln!(
             "  {:>5}  {:>11}  {:>12}  {:>22}  {:>12}  {:>21}",
             v.level,
             v.per_side,

@@ -1,6 +1,19 @@
 //! `pmc`: planetary marching cubes from the command line.
 #![forbid(unsafe_code)]
 
+/// `println!` for what a command prints on standard output: a reader that went away
+/// (`pmc dem info earth.pmcdem | head -3`) ends the program quietly with the status a shell
+/// gives a command stopped by SIGPIPE (141), as Unix tools do, and any other write error (a full
+/// disk) is reported on standard error with status 1, instead of a panic.
+macro_rules! outln {
+    () => {
+        $crate::stdout_line(format_args!(""))
+    };
+    ($($t:tt)*) => {
+        $crate::stdout_line(format_args!($($t)*))
+    };
+}
+
 mod dem;
 mod edit;
 mod error;
@@ -48,6 +61,18 @@ enum Command {
     /// Imagery draped on a planet: import a colour image (JPEG, PNG, GeoTIFF) into a .pmcimg
     /// file for `pmc serve --imagery`, describe the file, look up its colour at a place.
     Imagery(imagery::ImageryArgs),
+}
+
+/// Writes one line to standard output (see `outln!`).
+pub(crate) fn stdout_line(line: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    if let Err(e) = writeln!(std::io::stdout().lock(), "{line}") {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(141);
+        }
+        eprintln!("error: writing to standard output: {e}");
+        std::process::exit(1);
+    }
 }
 
 fn main() -> ExitCode {

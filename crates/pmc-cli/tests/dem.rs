@@ -322,3 +322,25 @@ fn bad_input_is_refused_and_leaves_no_file() {
     );
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `pmc dem info earth.pmcdem | head -3` panicked ("failed printing to stdout: Broken pipe") when
+/// the reader went away before pmc wrote: now pmc stops quietly with the status a shell gives a
+/// command stopped by SIGPIPE.
+#[test]
+fn pmc_dem_info_into_head_panicked_on_the_closed_pipe() {
+    use std::process::Stdio;
+    let file = fixture("etopo60_l6_v1.pmcdem");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pmc"))
+        .args(["dem", "info", &file])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("pmc runs");
+    // the reader goes away before pmc has opened the file, let alone written a line
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("pmc ends");
+    let e = text(&o.stderr);
+    assert!(!e.contains("panicked"), "pmc panicked: {e}");
+    assert_eq!(o.status.code(), Some(141), "{e}");
+    assert!(e.is_empty(), "nothing on standard error either: {e}");
+}
