@@ -7,10 +7,12 @@
 
 /**
  * Pixels of the back-face flag colour (#ff00ff), within `tolerance` summed over the channels: a
- * gap a pixel wide or more. Sub-pixel slivers along chunk seams far away, where the flag colour
- * only tints an antialiased pixel, are not counted: they come from rasterising the two sides of a
- * seam from float32 positions relative to different chunk origins, not from the meshes, whose
- * closedness the Rust tests prove by vertex key.
+ * gap a pixel wide or more. Pixels the flag colour only tints (a few antialiasing samples of a
+ * pixel) are not counted: they lie inside chunks at the silhouettes of small relief seen at
+ * grazing angles, not along chunk borders (the chunk-border overlay shows them apart), and stay
+ * the same with every copy of a border vertex rasterised on the same bits (eye-relative
+ * positions) and with a back-face depth offset 25 times larger; the meshes' closedness is proven
+ * by vertex key in the Rust tests.
  */
 export function flaggedPixels(img, tolerance = 60) {
   let n = 0;

@@ -9,6 +9,8 @@ export const CHUNK_VERSION = 1;
 export const HEADER_BYTES = 56;
 /** Flag bit 0: indices are u32 (else u16). */
 export const FLAG_U32_INDICES = 1;
+/** Flag bit 1: the positions' low-order parts follow the positions. */
+export const FLAG_POSITIONS_LOW = 2;
 
 export const FACE_NAMES = ['top', 'bottom', 'north', 'south', 'east', 'west'] as const;
 export type FaceName = (typeof FACE_NAMES)[number];
@@ -26,6 +28,12 @@ export interface DecodedChunk {
   indexCount: number;
   /** f32 x 3 per vertex, relative to `origin`. */
   positions: Float32Array;
+  /**
+   * What f32 could not hold of each position (f32 x 3 per vertex, flag bit 1), or null: then
+   * `origin + positions + positionsLow` (in f64) is the vertex's place to about 1e-14 of the
+   * chunk's size, the same for every chunk's copy of a border vertex.
+   */
+  positionsLow: Float32Array | null;
   /** snorm i8 x 3 per vertex (component = round(n * 127)). */
   normals: Int8Array;
   /** Linear RGBA u8 x 4 per vertex. */
@@ -44,11 +52,15 @@ export interface DecodedChunk {
 
 const pad4 = (n: number): number => (n + 3) & ~3;
 
-/** Byte length of an encoded chunk with `v` vertices and `i` indices (u32 when `u32Indices`). */
-export function encodedLength(v: number, i: number, u32Indices: boolean): number {
+/**
+ * Byte length of an encoded chunk with `v` vertices and `i` indices (u32 when `u32Indices`), with
+ * the positions' low-order parts when `low`.
+ */
+export function encodedLength(v: number, i: number, u32Indices: boolean, low = false): number {
   return (
     HEADER_BYTES +
     12 * v +
+    (low ? 12 * v : 0) +
     pad4(3 * v) +
     4 * v +
     4 * v +
@@ -102,10 +114,11 @@ export function decodeChunk(input: ArrayBufferLike | ArrayBufferView): DecodedCh
     fail(`unsupported version ${version}, this viewer reads version ${CHUNK_VERSION}`);
   }
   const flags = view.getUint16(6, true);
-  if ((flags & ~FLAG_U32_INDICES) !== 0) {
-    fail(`unknown flags 0x${flags.toString(16)} (only bit 0 is defined)`);
+  if ((flags & ~(FLAG_U32_INDICES | FLAG_POSITIONS_LOW)) !== 0) {
+    fail(`unknown flags 0x${flags.toString(16)} (only bits 0 and 1 are defined)`);
   }
   const u32 = (flags & FLAG_U32_INDICES) !== 0;
+  const low = (flags & FLAG_POSITIONS_LOW) !== 0;
   const face = view.getUint8(8);
   if (face >= FACE_NAMES.length) fail(`face index ${face} out of range 0..5`);
   const level = view.getUint8(9);
@@ -123,7 +136,7 @@ export function decodeChunk(input: ArrayBufferLike | ArrayBufferView): DecodedCh
   const vertexCount = view.getUint32(48, true);
   const indexCount = view.getUint32(52, true);
   if (indexCount % 3 !== 0) fail(`index count ${indexCount} is not a multiple of 3`);
-  const expected = encodedLength(vertexCount, indexCount, u32);
+  const expected = encodedLength(vertexCount, indexCount, u32, low);
   if (length !== expected) {
     fail(
       `length ${length} bytes differs from the ${expected} bytes that ${vertexCount} vertices and ` +
@@ -152,6 +165,14 @@ export function decodeChunk(input: ArrayBufferLike | ArrayBufferView): DecodedCh
     3 * vertexCount,
     4,
   );
+  const positionsLow = low
+    ? section(
+        (b, o, n) => new Float32Array(b, o, n),
+        (c) => new Float32Array(c.buffer),
+        3 * vertexCount,
+        4,
+      )
+    : null;
   const normals = section(
     (b, o, n) => new Int8Array(b, o, n),
     (c) => new Int8Array(c.buffer),
@@ -212,6 +233,7 @@ export function decodeChunk(input: ArrayBufferLike | ArrayBufferView): DecodedCh
     vertexCount,
     indexCount,
     positions,
+    positionsLow,
     normals,
     colors,
     heights,

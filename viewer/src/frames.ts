@@ -139,6 +139,38 @@ export function relativeToCamera(point: V3, camera: V3, out: V3 = [0, 0, 0]): V3
 }
 
 /**
+ * Eye-relative positions from high and low f32 parts (as CesiumJS draws its globe): every vertex
+ * of a chunk at its planet-frame place `origin + positions + low` (summed in f64: the same sum,
+ * in the same order, as the server's), split into `high = f32(p)` and `low = f32(p - high)`.
+ * The terrain shader draws `(high - eyeHigh) + (low - eyeLow)` with the eye split the same way
+ * (`splitHighLow`), so the copies of a border vertex in two chunks, which the server's low parts
+ * bring to the same place far below a micrometre, rasterise identically whatever their chunks'
+ * origins: no hairline gap between chunks. `low` null: the positions alone.
+ */
+export function splitPositions(
+  origin: V3,
+  positions: Float32Array,
+  low: Float32Array | null,
+): { high: Float32Array; low: Float32Array } {
+  const n = positions.length;
+  const high = new Float32Array(n);
+  const rest = new Float32Array(n);
+  for (let i = 0; i < n; i++) {
+    const p = origin[i % 3]! + positions[i]! + (low ? low[i]! : 0);
+    const h = Math.fround(p);
+    high[i] = h;
+    rest[i] = p - h;
+  }
+  return { high, low: rest };
+}
+
+/** A planet-frame point split into high and low f32 parts (see `splitPositions`). */
+export function splitHighLow(p: V3): { high: V3; low: V3 } {
+  const high: V3 = [Math.fround(p[0]), Math.fround(p[1]), Math.fround(p[2])];
+  return { high, low: [Math.fround(p[0] - high[0]), Math.fround(p[1] - high[1]), Math.fround(p[2] - high[2])] };
+}
+
+/**
  * `x mod period` in [0, period), computed in f64. The terrain shader takes each chunk origin
  * modulo the period of its noise lattice, so the noise of `origin + position` stays continuous
  * across chunks while every number the GPU sees stays small.

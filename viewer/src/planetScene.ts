@@ -8,7 +8,7 @@ import { Atmosphere, type SkySettings } from './atmosphere';
 import { SPACE, type AtmosphereParams } from './atmosphereModel';
 import type { DecodedChunk } from './chunkDecode';
 import { boundaryEdges } from './boundaryEdges';
-import { modPositive, relativeToCamera, type V3 } from './frames';
+import { modPositive, relativeToCamera, splitHighLow, splitPositions, type V3 } from './frames';
 import { imageryCellMetres, type ImageryInfo } from './imagery';
 import { materialUniforms } from './materials';
 import { pushUniform, pushUniforms } from './pictureKey';
@@ -82,6 +82,9 @@ export class PlanetScene {
   private readonly shared = {
     ...this.atmosphere.uniforms,
     uSunDir: { value: new THREE.Vector3(0, 1, 0) },
+    // the eye's place in high and low f32 parts (frames.ts splitPositions)
+    uEyeHigh: { value: new THREE.Vector3() },
+    uEyeLow: { value: new THREE.Vector3() },
     uMatA: { value: Array.from({ length: 10 }, () => new THREE.Vector3(1, 1, 1)) },
     uMatB: { value: Array.from({ length: 10 }, () => new THREE.Vector3(1, 1, 1)) },
     uMatHeights: { value: new THREE.Vector4(1e30, 0, 1e30, 1e30) },
@@ -324,6 +327,9 @@ export class PlanetScene {
     if (chunk.indexCount === 0 || !this.params) return;
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(chunk.positions, 3));
+    const split = splitPositions(chunk.origin, chunk.positions, chunk.positionsLow);
+    g.setAttribute('aPosHigh', new THREE.BufferAttribute(split.high, 3));
+    g.setAttribute('aPosLow', new THREE.BufferAttribute(split.low, 3));
     g.setAttribute('normal', new THREE.BufferAttribute(chunk.normals, 3, true));
     g.setAttribute('aColor', new THREE.BufferAttribute(chunk.colors, 4, true));
     g.setAttribute('aHeight', new THREE.BufferAttribute(chunk.heights, 1));
@@ -468,6 +474,9 @@ export class PlanetScene {
 
   /** Floating origin: places every object relative to the camera (f64 in, small f32 out). */
   place(camera: V3): void {
+    const eye = splitHighLow(camera);
+    this.shared.uEyeHigh.value.set(...eye.high);
+    this.shared.uEyeLow.value.set(...eye.low);
     const rel: V3 = [0, 0, 0];
     for (const obj of this.chunks.values()) {
       relativeToCamera(obj.origin, camera, rel);

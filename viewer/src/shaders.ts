@@ -56,7 +56,10 @@ vec4 pmcSeaSurface(vec3 below, vec3 n, vec3 v) {
   float fresnel = 0.02 + 0.98 * pow(1.0 - cosV, 5.0);
   float diffuse = max(dot(n, uSunDir), 0.0);
   vec3 hv = normalize(uSunDir + v);
-  float spec = pow(max(dot(n, hv), 0.0), 120.0) * step(0.0, diffuse);
+  // the glint: a small bright core and a faint sheen round it (waves spread it); one broad
+  // lobe washed a kilometres-wide disk of the sea out to white seen from high up
+  float nh = max(dot(n, hv), 0.0);
+  float spec = (pow(nh, 900.0) + 0.06 * pow(nh, 90.0)) * step(0.0, diffuse);
   vec3 colour = uSeaColour * (0.35 + 0.65 * diffuse);
   colour = mix(colour, uSkyColour, fresnel * 0.8) + vec3(1.0, 0.97, 0.9) * spec * 0.8;
   float alpha = clamp(0.35 + 0.55 * pow(1.0 - cosV, 2.0) + spec, 0.0, 0.96);
@@ -69,6 +72,10 @@ attribute vec4 aColor;
 attribute float aHeight;
 attribute float aWaterDepth;
 attribute float aMaterial;
+attribute vec3 aPosHigh;  // the vertex's planet-frame place, high and low f32 parts (frames.ts)
+attribute vec3 aPosLow;
+uniform vec3 uEyeHigh;    // the eye's place, split the same way
+uniform vec3 uEyeLow;
 uniform vec3 uOrigin;     // chunk origin (f32: used for directions only)
 uniform vec3 uOriginMod;  // chunk origin modulo the noise period (computed in f64)
 uniform float uNoiseFreq;
@@ -85,7 +92,9 @@ varying vec3 vDetailPos;
 #include <common>
 #include <logdepthbuf_pars_vertex>
 void main() {
-  vec4 world = modelMatrix * vec4(position, 1.0);
+  // relative to the eye from the high and low parts, not modelMatrix * position: every copy of
+  // a border vertex (one place, chunks of other origins) then lands on the same bits
+  vec4 world = vec4((aPosHigh - uEyeHigh) + (aPosLow - uEyeLow), 1.0);
   vRel = world.xyz;
   vDetailPos = (uOriginModDetail + position) * uDetailFreq;
   vColor = aColor.rgb;

@@ -140,6 +140,25 @@ describe('decodeChunk on synthetic buffers', () => {
     expect([...c.materials]).toEqual([0, 3, 5]);
   });
 
+  it('reads the positions\' low-order parts (flag bit 1), and none without the flag', () => {
+    const lows = [
+      [1e-8, -2e-8, 0],
+      [0, 0, 3e-9],
+      [-1e-9, 5e-9, 7e-9],
+    ];
+    const bytes = encodeChunk({ ...triangle, positionsLow: lows });
+    expect(bytes.byteLength).toBe(encodedLength(3, 3, false, true));
+    const c = decodeChunk(bytes);
+    expect([...c.positions]).toEqual([...decodeChunk(encodeChunk(triangle)).positions]);
+    expect([...c.positionsLow!]).toEqual(lows.flat().map(Math.fround));
+    expect([...c.heights]).toEqual([1.5, -2.5, 3]);
+    expect(decodeChunk(encodeChunk(triangle)).positionsLow).toBeNull();
+    // the flag without the section is a length error
+    const lying = encodeChunk(triangle);
+    new DataView(lying.buffer).setUint16(6, 2, true);
+    expect(() => decodeChunk(lying)).toThrow(/length/);
+  });
+
   it('reads u32 indices (flag bit 0)', () => {
     const bytes = encodeChunk({ ...triangle, u32: true });
     expect(bytes.byteLength).toBe(encodedLength(3, 3, true));
@@ -216,7 +235,7 @@ describe('decodeChunk rejects invalid buffers with a descriptive error', () => {
 
   it('unknown flags', () => {
     const b = good();
-    new DataView(b.buffer).setUint16(6, 2, true);
+    new DataView(b.buffer).setUint16(6, 4, true);
     expect(() => decodeChunk(b)).toThrow(/unknown flags/);
   });
 

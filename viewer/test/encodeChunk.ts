@@ -9,6 +9,8 @@ export interface ChunkInput {
   k?: number;
   origin?: [number, number, number];
   positions: number[][];
+  /** The positions' low-order parts (flag bit 1), when given. */
+  positionsLow?: number[][];
   normals?: number[][];
   colors?: number[][];
   heights?: number[];
@@ -25,13 +27,14 @@ export function encodeChunk(c: ChunkInput): Uint8Array<ArrayBuffer> {
   const V = c.positions.length;
   const I = c.indices.length;
   const u32 = c.u32 ?? V > 65536;
+  const low = c.positionsLow !== undefined;
   const size =
-    56 + 12 * V + pad4(3 * V) + 4 * V + 4 * V + 4 * V + pad4(V) + pad4((u32 ? 4 : 2) * I);
+    56 + 12 * V + (low ? 12 * V : 0) + pad4(3 * V) + 4 * V + 4 * V + 4 * V + pad4(V) + pad4((u32 ? 4 : 2) * I);
   const bytes = new Uint8Array(size);
   const dv = new DataView(bytes.buffer);
   bytes.set([0x50, 0x4d, 0x43, 0x4d], 0);
   dv.setUint16(4, 1, true);
-  dv.setUint16(6, u32 ? 1 : 0, true);
+  dv.setUint16(6, (u32 ? 1 : 0) | (low ? 2 : 0), true);
   dv.setUint8(8, c.face ?? 0);
   dv.setUint8(9, c.level ?? 0);
   dv.setUint32(12, c.i ?? 0, true);
@@ -45,6 +48,7 @@ export function encodeChunk(c: ChunkInput): Uint8Array<ArrayBuffer> {
   dv.setUint32(52, I, true);
   let at = 56;
   for (const p of c.positions) for (const x of p) { dv.setFloat32(at, x, true); at += 4; }
+  for (const p of c.positionsLow ?? []) for (const x of p) { dv.setFloat32(at, x, true); at += 4; }
   for (let v = 0; v < V; v++) {
     const n = c.normals?.[v] ?? [0, 1, 0];
     for (const x of n) { dv.setInt8(at, Math.round(x * 127)); at += 1; }

@@ -12,6 +12,8 @@ import {
   normalize,
   positionFromLatLon,
   relativeToCamera,
+  splitHighLow,
+  splitPositions,
   sub,
   wrapLon,
   type V3,
@@ -178,5 +180,65 @@ describe('floating origin', () => {
     expect(modPositive(-1, period)).toBeCloseTo(period - 1, 9);
     // the noise sees the same relative offset between the chunks (unless one wrapped)
     expect(mb - ma).toBeCloseTo(45.25, 9);
+  });
+});
+
+describe('eye-relative positions from high and low parts', () => {
+  // the server's way: a place p (f64) stored relative to a chunk origin as f32 high and low parts
+  const store = (p: V3, o: V3): { pos: number[]; low: number[] } => {
+    const pos = [0, 1, 2].map((n) => Math.fround(p[n]! - o[n]!));
+    return { pos, low: [0, 1, 2].map((n) => Math.fround(p[n]! - o[n]! - pos[n]!)) };
+  };
+  /** The shader's sum, with every operation rounded to f32. */
+  const eyeRelative = (high: number[], low: number[], eye: V3): number[] => {
+    const e = splitHighLow(eye);
+    const f = Math.fround;
+    return [0, 1, 2].map((n) => f(f(high[n]! - e.high[n]!) + f(low[n]! - e.low[n]!)));
+  };
+
+  it('draws the copies of a vertex in chunks of other origins on the same bits, where the f32 offsets alone do not', () => {
+    let seed = 7;
+    const rand = (): number => {
+      seed = (seed * 16807) % 2147483647;
+      return seed / 2147483647;
+    };
+    let same = 0;
+    let sameWithoutLow = 0;
+    const trials = 2000;
+    for (let t = 0; t < trials; t++) {
+      // a place on the Earth's surface, two chunk origins up to 300 km away, the eye 10 km off
+      const dir = normalize([rand() - 0.5, rand() - 0.5, rand() - 0.5]);
+      const p: V3 = [dir[0] * 6371000.3, dir[1] * 6371000.3, dir[2] * 6371000.3];
+      const o1: V3 = [p[0] + 3e5 * (rand() - 0.5), p[1] + 3e5 * (rand() - 0.5), p[2] + 3e5 * (rand() - 0.5)];
+      const o2: V3 = [p[0] + 3e3 * (rand() - 0.5), p[1] + 3e3 * (rand() - 0.5), p[2] + 3e3 * (rand() - 0.5)];
+      const eye: V3 = [p[0] + 1e4 * (rand() - 0.5), p[1] + 1e4 * (rand() - 0.5), p[2] + 1e4 * (rand() - 0.5)];
+      const a = store(p, o1);
+      const b = store(p, o2);
+      const sa = splitPositions(o1, new Float32Array(a.pos), new Float32Array(a.low));
+      const sb = splitPositions(o2, new Float32Array(b.pos), new Float32Array(b.low));
+      expect([...sa.high]).toEqual([...sb.high]);
+      const ra = eyeRelative([...sa.high], [...sa.low], eye);
+      const rb = eyeRelative([...sb.high], [...sb.low], eye);
+      if (ra.every((x, n) => x === rb[n])) same++;
+      // without the low parts (as before): the chunks' f32 offsets alone
+      const na = splitPositions(o1, new Float32Array(a.pos), null);
+      const nb = splitPositions(o2, new Float32Array(b.pos), null);
+      const qa = eyeRelative([...na.high], [...na.low], eye);
+      const qb = eyeRelative([...nb.high], [...nb.low], eye);
+      if (qa.every((x, n) => x === qb[n])) sameWithoutLow++;
+      // and the eye-relative place is right to a fraction of a millimetre
+      for (let n = 0; n < 3; n++) expect(Math.abs(ra[n]! - (p[n]! - eye[n]!))).toBeLessThan(1e-3);
+    }
+    expect(same).toBeGreaterThanOrEqual(trials - 2);
+    expect(sameWithoutLow).toBeLessThan(trials / 2);
+  });
+
+  it('splits a point into an f32 and the f32 of the rest', () => {
+    const { high, low } = splitHighLow([6371000.123456789, -1.5, 1e-12]);
+    expect(high[0]).toBe(Math.fround(6371000.123456789));
+    expect(low[0]).toBe(Math.fround(6371000.123456789 - high[0]));
+    expect(Math.abs(high[0] + low[0] - 6371000.123456789)).toBeLessThan(1e-8);
+    expect(high[1]).toBe(-1.5);
+    expect(low[1]).toBe(0);
   });
 });

@@ -53,6 +53,12 @@ fn check_mesh(m: &ChunkMesh) -> Result<bool, String> {
     if m.normals.len() != n {
         return Err(format!("normals has {} entries but positions has {n}", m.normals.len()));
     }
+    if !m.positions_low.is_empty() && m.positions_low.len() != n {
+        return Err(format!(
+            "positions_low has {} entries but positions has {n} (it must be empty or match)",
+            m.positions_low.len()
+        ));
+    }
     if !m.edge_keys.is_empty() && m.edge_keys.len() != n {
         return Err(format!(
             "edge_keys has {} entries but positions has {n} (it must be empty or match)",
@@ -86,6 +92,9 @@ fn check_mesh(m: &ChunkMesh) -> Result<bool, String> {
     }
     if let Some(i) = m.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
         return Err(format!("position {i} {:?} is not finite", m.positions[i]));
+    }
+    if let Some(i) = m.positions_low.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(format!("position low part {i} {:?} is not finite", m.positions_low[i]));
     }
     if let Some(i) = m.normals.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
         return Err(format!("normal {i} {:?} is not finite", m.normals[i]));

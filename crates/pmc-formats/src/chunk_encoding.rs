@@ -6,7 +6,8 @@
 //! [`ChunkDecodeError`] and never panics.
 //!
 //! Layout: a 56-byte header (magic `PMCM`, version 1, flags, the chunk key, the `f64` origin,
-//! vertex and index counts), then the sections positions (`f32 x 3`), normals (`i8 x 3` snorm),
+//! vertex and index counts), then the sections positions (`f32 x 3`), with flag bit 1 their
+//! low-order parts (`f32 x 3`, see [`ChunkMesh::positions_low`]), normals (`i8 x 3` snorm),
 //! colours (`u8 x 4`), heights (`f32`), water depths (`f32`), materials (`u8`) and indices (`u16`,
 //! or `u32` when there are more than 65536 vertices), each padded with zeros to a multiple of 4
 //! bytes. Everything is little-endian.
@@ -44,6 +45,10 @@ pub const VERSION: u16 = 1;
 pub const HEADER_LEN: usize = 56;
 /// Flag bit 0: indices are `u32` (else `u16`).
 pub const FLAG_U32_INDICES: u16 = 1;
+/// Flag bit 1: a section of the positions' low-order parts follows the positions.
+pub const FLAG_POSITIONS_LOW: u16 = 2;
+/// Every flag bit this reader knows.
+const KNOWN_FLAGS: u16 = FLAG_U32_INDICES | FLAG_POSITIONS_LOW;
 /// The most vertices a chunk with `u16` indices may have.
 pub const MAX_U16_VERTICES: usize = 65536;
 /// Colour written for every vertex of a mesh without attributes (opaque white).
@@ -60,6 +65,8 @@ pub struct DecodedChunk {
     pub origin: DVec3,
     /// Vertex positions relative to `origin`, metres.
     pub positions: Vec<[f32; 3]>,
+    /// Their low-order parts (flag bit 1; see [`ChunkMesh::positions_low`]), empty without.
+    pub positions_low: Vec<[f32; 3]>,
     /// Unit outward normals as stored: snorm bytes, `round(n * 127)`. See
     /// [`DecodedChunk::unit_normals`].
     pub normals: Vec<[i8; 3]>,
@@ -101,6 +108,7 @@ impl DecodedChunk {
             key: Some(self.key),
             origin: self.origin,
             positions: self.positions.clone(),
+            positions_low: self.positions_low.clone(),
             normals: self.unit_normals(),
             indices: self.indices.clone(),
             edge_keys: Vec::new(),
@@ -127,8 +135,8 @@ pub enum ChunkDecodeError {
     /// A version this reader does not know.
     #[error("chunk encoding version {0} is not supported (this reader knows version {VERSION})")]
     UnsupportedVersion(u16),
-    /// Flag bits other than bit 0 are set.
-    #[error("unknown flag bits {0:#06x} are set (only bit 0 is defined)")]
+    /// Flag bits other than bits 0 and 1 are set.
+    #[error("unknown flag bits {0:#06x} are set (only bits 0 and 1 are defined)")]
     UnknownFlags(u16),
     /// The reserved header field is not 0.
     #[error("the reserved header field is {0}, expected 0")]
@@ -185,10 +193,12 @@ fn snorm_to_f32(c: i8) -> f32 {
     (f32::from(c) / 127.0).max(-1.0)
 }
 
-/// Byte sizes of the sections (unpadded) for `v` vertices and `i` indices of `index_size` bytes.
-fn section_sizes(v: u64, i: u64, index_size: u64) -> [(&'static str, u64); 7] {
+/// Byte sizes of the sections (unpadded) for `v` vertices and `i` indices of `index_size` bytes,
+/// with the positions' low-order parts when `low` (else that section is 0 bytes).
+fn section_sizes(v: u64, i: u64, index_size: u64, low: bool) -> [(&'static str, u64); 8] {
     [
         ("positions", 12 * v),
+        ("positions low", if low { 12 * v } else { 0 }),
         ("normals", 3 * v),
         ("colors", 4 * v),
         ("heights", 4 * v),
@@ -198,11 +208,12 @@ fn section_sizes(v: u64, i: u64, index_size: u64) -> [(&'static str, u64); 7] {
     ]
 }
 
-/// The exact encoded length of a chunk with `v` vertices and `i` indices.
-pub fn encoded_len(v: u64, i: u64) -> u64 {
+/// The exact encoded length of a chunk with `v` vertices and `i` indices, with the positions'
+/// low-order parts when `low`.
+pub fn encoded_len(v: u64, i: u64, low: bool) -> u64 {
     let index_size = if v > MAX_U16_VERTICES as u64 { 4 } else { 2 };
     HEADER_LEN as u64
-        + section_sizes(v, i, index_size)
+        + section_sizes(v, i, index_size, low)
             .iter()
             .map(|&(_, s)| pad4(s))
             .sum::<u64>()
@@ -245,11 +256,14 @@ pub fn encode_chunk(mesh: &ChunkMesh, out: &mut Vec<u8>) -> Result<(), ExportErr
         )));
     };
     let wide = v > MAX_U16_VERTICES;
+    // (an empty chunk has no positions, so no low parts either)
+    let low = v > 0 && mesh.positions_low.len() == v;
     let start = out.len();
-    out.reserve(encoded_len(v as u64, i as u64) as usize);
+    out.reserve(encoded_len(v as u64, i as u64, low) as usize);
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&(if wide { FLAG_U32_INDICES } else { 0 }).to_le_bytes());
+    let flags = (if wide { FLAG_U32_INDICES } else { 0 }) | (if low { FLAG_POSITIONS_LOW } else { 0 });
+    out.extend_from_slice(&flags.to_le_bytes());
     out.push(key.face.index() as u8);
     out.push(key.level);
     out.extend_from_slice(&0u16.to_le_bytes());
@@ -268,6 +282,13 @@ pub fn encode_chunk(mesh: &ChunkMesh, out: &mut Vec<u8>) -> Result<(), ExportErr
     for p in &mesh.positions {
         for c in p {
             out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    if low {
+        for p in &mesh.positions_low {
+            for c in p {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
         }
     }
     for n in &mesh.normals {
@@ -301,7 +322,7 @@ pub fn encode_chunk(mesh: &ChunkMesh, out: &mut Vec<u8>) -> Result<(), ExportErr
         }
     }
     pad_to_4(out, start);
-    debug_assert_eq!((out.len() - start) as u64, encoded_len(v as u64, i as u64));
+    debug_assert_eq!((out.len() - start) as u64, encoded_len(v as u64, i as u64, low));
     Ok(())
 }
 
@@ -369,10 +390,11 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
         return Err(ChunkDecodeError::UnsupportedVersion(version));
     }
     let flags = r.u16();
-    if flags & !FLAG_U32_INDICES != 0 {
-        return Err(ChunkDecodeError::UnknownFlags(flags & !FLAG_U32_INDICES));
+    if flags & !KNOWN_FLAGS != 0 {
+        return Err(ChunkDecodeError::UnknownFlags(flags & !KNOWN_FLAGS));
     }
     let u32_flag = flags & FLAG_U32_INDICES != 0;
+    let low = flags & FLAG_POSITIONS_LOW != 0;
     let [face_byte, level] = r.take();
     let face = Face::from_index(usize::from(face_byte)).ok_or(ChunkDecodeError::BadFace(face_byte))?;
     let reserved = r.u16();
@@ -392,7 +414,7 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
             u32_flag,
         });
     }
-    let expected = encoded_len(u64::from(v32), u64::from(i32_));
+    let expected = encoded_len(u64::from(v32), u64::from(i32_), low);
     if expected != bytes.len() as u64 {
         return Err(ChunkDecodeError::Length {
             expected,
@@ -402,14 +424,17 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
     // The length matches, so every count below fits in memory the caller already holds.
     let (v, n_idx) = (v32 as usize, i32_ as usize);
     let start = 0;
-    let positions = r
-        .slice(12 * v)
-        .chunks_exact(12)
-        .map(|c| {
-            let f = |o: usize| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]]);
-            [f(0), f(4), f(8)]
-        })
-        .collect();
+    let mut vec3s = |n: usize| -> Vec<[f32; 3]> {
+        r.slice(12 * n)
+            .chunks_exact(12)
+            .map(|c| {
+                let f = |o: usize| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]]);
+                [f(0), f(4), f(8)]
+            })
+            .collect()
+    };
+    let positions = vec3s(v);
+    let positions_low = if low { vec3s(v) } else { Vec::new() };
     let normals = r
         .slice(3 * v)
         .chunks_exact(3)
@@ -453,6 +478,7 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
         key: ChunkKey { face, level, i, j, k },
         origin,
         positions,
+        positions_low,
         normals,
         colors,
         heights,
@@ -480,14 +506,46 @@ mod tests {
 
     #[test]
     fn lengths_follow_the_spec() {
-        assert_eq!(encoded_len(0, 0), 56);
+        assert_eq!(encoded_len(0, 0, false), 56);
         // 5 vertices, 6 u16 indices: 60 + 16 + 20 + 20 + 20 + 8 + 12.
-        assert_eq!(encoded_len(5, 6), 56 + 156);
-        assert_eq!(encoded_len(65536, 3), 56 + 65536 * 28 + 8);
+        assert_eq!(encoded_len(5, 6, false), 56 + 156);
+        // the positions' low-order parts: 12 more bytes a vertex
+        assert_eq!(encoded_len(5, 6, true), 56 + 156 + 60);
+        assert_eq!(encoded_len(65536, 3, false), 56 + 65536 * 28 + 8);
         assert_eq!(
-            encoded_len(65537, 3),
+            encoded_len(65537, 3, false),
             56 + 65537 * 24 + pad4(65537 * 3) + pad4(65537) + 12
         );
+    }
+
+    #[test]
+    fn positions_low_round_trip_under_flag_bit_1() {
+        let mut m = tri(5);
+        m.positions_low = (0..5).map(|i| [i as f32 * 1e-8, -3e-9, 0.0]).collect();
+        let mut b = Vec::new();
+        encode_chunk(&m, &mut b).unwrap();
+        assert_eq!(b.len() as u64, encoded_len(5, 3, true));
+        assert_eq!(u16::from_le_bytes([b[6], b[7]]), FLAG_POSITIONS_LOW);
+        let d = decode_chunk(&b).unwrap();
+        assert_eq!(d.positions, m.positions);
+        assert_eq!(d.positions_low, m.positions_low);
+        assert_eq!(d.to_chunk_mesh().positions_low, m.positions_low);
+        // a mesh without them: no flag, no section, and none read back
+        m.positions_low.clear();
+        let mut plain = Vec::new();
+        encode_chunk(&m, &mut plain).unwrap();
+        assert_eq!(plain.len() + 60, b.len());
+        assert_eq!(u16::from_le_bytes([plain[6], plain[7]]), 0);
+        assert!(decode_chunk(&plain).unwrap().positions_low.is_empty());
+        // the flag without the section's bytes is a length error, not a misread
+        let mut lying = plain.clone();
+        lying[6] = FLAG_POSITIONS_LOW as u8;
+        assert!(matches!(decode_chunk(&lying), Err(ChunkDecodeError::Length { .. })));
+        // low parts of the wrong count or not finite are refused by the writer
+        m.positions_low = vec![[0.0; 3]; 4];
+        assert!(encode_chunk(&m, &mut Vec::new()).is_err());
+        m.positions_low = vec![[f32::NAN, 0.0, 0.0]; 5];
+        assert!(encode_chunk(&m, &mut Vec::new()).is_err());
     }
 
     #[test]
@@ -497,7 +555,7 @@ mod tests {
             m.indices = vec![0, 1, (n - 1) as u32, (n - 1) as u32, (n - 2) as u32, 7];
             let mut b = Vec::new();
             encode_chunk(&m, &mut b).unwrap();
-            assert_eq!(b.len() as u64, encoded_len(n as u64, 6));
+            assert_eq!(b.len() as u64, encoded_len(n as u64, 6, false));
             assert_eq!(u16::from_le_bytes([b[6], b[7]]) & FLAG_U32_INDICES != 0, wide);
             let d = decode_chunk(&b).unwrap();
             assert_eq!(d.u32_indices, wide);
@@ -528,7 +586,7 @@ mod tests {
         };
         assert!(matches!(with(0, b'X'), Err(ChunkDecodeError::BadMagic(_))));
         assert_eq!(with(4, 2), Err(ChunkDecodeError::UnsupportedVersion(2)));
-        assert_eq!(with(6, 2), Err(ChunkDecodeError::UnknownFlags(2)));
+        assert_eq!(with(6, 4), Err(ChunkDecodeError::UnknownFlags(4)));
         assert!(matches!(with(6, 1), Err(ChunkDecodeError::IndexWidth { .. })));
         assert_eq!(with(8, 6), Err(ChunkDecodeError::BadFace(6)));
         assert_eq!(with(10, 1), Err(ChunkDecodeError::Reserved(1)));

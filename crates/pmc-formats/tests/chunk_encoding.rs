@@ -126,7 +126,7 @@ fn shared_test_vector_matches_the_committed_fixture() {
     let mesh = fixture_mesh();
     let mut bytes = Vec::new();
     encode_chunk(&mesh, &mut bytes).unwrap();
-    assert_eq!(bytes.len() as u64, encoded_len(5, 6));
+    assert_eq!(bytes.len() as u64, encoded_len(5, 6, false));
     assert_eq!(bytes.len(), 212);
     let decoded = decode_chunk(&bytes).unwrap();
     assert_round_trip(&mesh, &decoded);
@@ -287,7 +287,7 @@ proptest! {
     fn decode_inverts_encode(m in arb_mesh()) {
         let mut b = Vec::new();
         encode_chunk(&m, &mut b).unwrap();
-        prop_assert_eq!(b.len() as u64, encoded_len(if m.indices.is_empty() { 0 } else { m.positions.len() as u64 }, m.indices.len() as u64));
+        prop_assert_eq!(b.len() as u64, encoded_len(if m.indices.is_empty() { 0 } else { m.positions.len() as u64 }, m.indices.len() as u64, !m.indices.is_empty() && m.positions_low.len() == m.positions.len()));
         prop_assert_eq!(b.len() % 4, 0);
         let d = decode_chunk(&b).unwrap();
         if m.indices.is_empty() {

@@ -301,19 +301,21 @@ fn write_mesh<H: LatticeHeights + ?Sized>(samples: &Samples<'_, H>, hs: &[f64], 
     out.origin = origin;
     let n = SIDE * SIDE;
     out.positions.resize(n, [0.0; 3]);
+    out.positions_low.resize(n, [0.0; 3]);
     out.normals.resize(n, [0.0; 3]);
     out.edge_keys.resize(n, EdgeKey(0, 0));
     out.heights.resize(n, 0.0);
     let rows = out
         .positions
         .chunks_exact_mut(SIDE)
+        .zip(out.positions_low.chunks_exact_mut(SIDE))
         .zip(out.normals.chunks_exact_mut(SIDE))
         .zip(
             out.edge_keys
                 .chunks_exact_mut(SIDE)
                 .zip(out.heights.chunks_exact_mut(SIDE)),
         );
-    for (b, ((positions, normals), (keys, heights))) in (0..=SEG).zip(rows) {
+    for (b, (((positions, lows), normals), (keys, heights))) in (0..=SEG).zip(rows) {
         let row = g(0, b);
         let (p_row, h_row, l_row) = (
             &pos[row..row + SIDE],
@@ -322,7 +324,9 @@ fn write_mesh<H: LatticeHeights + ?Sized>(samples: &Samples<'_, H>, hs: &[f64], 
         );
         for a in 0..SIDE {
             let d = p_row[a] - origin;
-            positions[a] = [d.x as f32, d.y as f32, d.z as f32];
+            let high = d.as_vec3();
+            positions[a] = high.to_array();
+            lows[a] = (d - high.as_dvec3()).as_vec3().to_array();
             heights[a] = h_row[a] as f32;
             let c = VoxelKey::new(canonical_lattice(l_row[a], m), 0).pack();
             keys[a] = EdgeKey(c, c);

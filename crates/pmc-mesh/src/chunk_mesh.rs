@@ -18,6 +18,14 @@ pub struct ChunkMesh {
     pub origin: DVec3,
     /// Vertex positions relative to `origin`.
     pub positions: Vec<[f32; 3]>,
+    /// What `f32` could not hold of each position: `(world - origin) - positions`, rounded to
+    /// `f32`, so `origin + positions + positions_low` is the world position to about `1e-14` of
+    /// the chunk's size. The copies of a vertex in neighbouring chunks (other origins, other
+    /// levels) then agree far below a millimetre, where `positions` alone differ by up to half an
+    /// `f32` step of the larger chunk (centimetres for chunks hundreds of kilometres wide): a
+    /// viewer that draws positions relative to the eye from high and low parts rasterises both
+    /// copies the same, with no hairline gap. Empty for meshes made without it (then all 0).
+    pub positions_low: Vec<[f32; 3]>,
     /// Unit outward normals, from the density gradient.
     pub normals: Vec<[f32; 3]>,
     /// Triangle list, three indices per triangle.
@@ -54,6 +62,7 @@ impl ChunkMesh {
         self.key = None;
         self.origin = DVec3::ZERO;
         self.positions.clear();
+        self.positions_low.clear();
         self.normals.clear();
         self.indices.clear();
         self.edge_keys.clear();
@@ -78,6 +87,16 @@ impl ChunkMesh {
     /// Whether the mesh has no triangles.
     pub fn is_empty(&self) -> bool {
         self.indices.is_empty()
+    }
+
+    /// [`ChunkMesh::world_position`] with [`ChunkMesh::positions_low`] added where the mesh has
+    /// them: the world position to about `1e-14` of the chunk's size.
+    pub fn world_position_full(&self, i: usize) -> DVec3 {
+        let low = self
+            .positions_low
+            .get(i)
+            .map_or(DVec3::ZERO, |l| DVec3::from(l.map(f64::from)));
+        self.world_position(i) + low
     }
 
     /// World position of vertex `i` (`origin + position`, in `f64`).

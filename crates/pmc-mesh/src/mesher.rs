@@ -397,7 +397,9 @@ impl Ctx<'_> {
         let rel = pos - g.origin;
         let out = &mut *self.out;
         let idx = out.positions.len() as u32;
-        out.positions.push(rel.as_vec3().to_array());
+        let high = rel.as_vec3();
+        out.positions.push(high.to_array());
+        out.positions_low.push((rel - high.as_dvec3()).as_vec3().to_array());
         out.normals.push((-grad).as_vec3().to_array());
         out.edge_keys
             .push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));

@@ -235,6 +235,8 @@ impl Ctx<'_> {
         let out = &mut *self.out;
         let idx = out.positions.len() as u32;
         out.positions.push(previous.positions[j]);
+        out.positions_low
+            .push(previous.positions_low.get(j).copied().unwrap_or([0.0; 3]));
         out.normals.push(previous.normals[j]);
         out.edge_keys.push(previous.edge_keys[j]);
         out.vertex_edges.push(previous.vertex_edges[j]);

@@ -560,3 +560,56 @@ fn seams_through_the_base_cache_are_byte_identical() {
         assert!(cached.base_cache_stats().unwrap().hits > 0);
     }
 }
+
+/// Thin dark lines along chunk borders (`docs/images/earth-10km.png`): the copies of a border
+/// vertex in two chunks were stored as `f32` offsets from two origins, so they came back up to
+/// half an `f32` step of the larger chunk apart (centimetres for chunks hundreds of kilometres
+/// wide) and the viewer rasterised them a hair apart, the sky showing through. With the
+/// positions' low-order parts every copy comes back to the same place far below a micrometre
+/// (what the viewer's eye-relative high/low positions need to rasterise them the same), at
+/// planetary scale as on a small planet, between chunks of one level and of two.
+#[test]
+fn copies_of_a_border_vertex_rasterised_a_hair_apart_drew_dark_lines() {
+    let earth = Planet::new(PresetKind::Earth, 7, PresetKind::Earth.default_layout(None).unwrap());
+    let small = small_planet(PresetKind::Earthlike, 7);
+    for planet in [&small, &earth] {
+        let layout = *planet.layout();
+        let top = layout.max_level();
+        // one face two levels finer than the rest, around the face's corner at the top
+        let (face, level, rest) = (Face::Top, top.saturating_sub(2), top.saturating_sub(1));
+        let mut leaves: BTreeSet<ChunkKey> = layout.chunks(rest).into_iter().filter(|k| k.face != face).collect();
+        leaves.extend(layout.chunks(level).into_iter().filter(|k| k.face == face));
+        let meshes = mesh_all(planet, &leaves);
+        let mut first: HashMap<EdgeKey, (DVec3, DVec3)> = HashMap::new();
+        let (mut shared, mut plain, mut full, mut radius) = (0usize, 0f64, 0f64, 0f64);
+        for m in &meshes {
+            assert_eq!(
+                m.positions_low.len(),
+                m.vertex_count(),
+                "{:?}: low parts for every vertex",
+                m.key
+            );
+            for i in 0..m.vertex_count() {
+                let (p, q) = (m.world_position(i), m.world_position_full(i));
+                radius = radius.max(q.length());
+                if let Some((p0, q0)) = first.insert(m.edge_keys[i], (p, q)) {
+                    shared += 1;
+                    plain = plain.max(p.distance(p0));
+                    full = full.max(q.distance(q0));
+                }
+            }
+        }
+        let what = format!("radius {radius:.0} m, {} chunks", meshes.len());
+        assert!(shared > 100, "{what}: only {shared} shared vertices");
+        // a few f64 steps at the radius: the sums' own rounding
+        let bound = 8.0 * radius * f64::EPSILON;
+        assert!(
+            full <= bound,
+            "{what}: copies {full:e} m apart with the low parts (bound {bound:e})"
+        );
+        assert!(
+            plain > 100.0 * full.max(bound / 8.0),
+            "{what}: without the low parts {plain:e} m apart, with {full:e}"
+        );
+    }
+}

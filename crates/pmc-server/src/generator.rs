@@ -197,6 +197,7 @@ struct Reuse {
 fn mesh_bytes(m: &ChunkMesh) -> u64 {
     use std::mem::size_of_val;
     let buffers = size_of_val(m.positions.as_slice())
+        + size_of_val(m.positions_low.as_slice())
         + size_of_val(m.normals.as_slice())
         + size_of_val(m.indices.as_slice())
         + size_of_val(m.edge_keys.as_slice())
