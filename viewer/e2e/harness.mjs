@@ -2,11 +2,21 @@
 // run on every exit, timeouts, child processes, and the steps with their results.
 
 import { spawn } from 'node:child_process';
+import { existsSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const here = dirname(fileURLToPath(import.meta.url));
 export const viewerDir = resolve(here, '..');
+/**
+ * The elevation model the steps import: PMC_E2E_DEM, else NOAA's ETOPO5 where Debian's
+ * ferret-datasets installs it (scripts/test.sh does), else pmc-dem's one-degree ETOPO60 fixture.
+ */
+export const DEM_SOURCE = process.env.PMC_E2E_DEM
+  ? resolve(process.env.PMC_E2E_DEM)
+  : existsSync('/usr/share/ferret-vis/data/etopo5.cdf')
+    ? '/usr/share/ferret-vis/data/etopo5.cdf'
+    : resolve(viewerDir, '../crates/pmc-dem/tests/fixtures/etopo60.cdf');
 export const distDir = join(viewerDir, 'dist');
 export const artifacts = join(here, 'artifacts');
 // PMC_BIN is relative to the working directory; the default to the repository's target/
@@ -30,10 +40,10 @@ export const CHROMIUM_ARGS = [
   '--no-first-run',
   '--disable-quic',
 ];
-// A guard against a hung run, not a speed test: software rendering of the per-pixel materials and
-// the sky makes a 2-core machine take about an hour over every step (about 15 minutes before
-// them; making the suite quick again is open work), and a loaded one takes longer.
-export const TOTAL_MS = 75 * 60_000;
+// A guard against a hung run, not a speed test: every step takes about 10 minutes on a 2-core
+// machine with software WebGL (the viewer draws only when the picture changes), a loaded machine
+// longer, and the gallery (PMC_E2E_GALLERY=1) adds its descents with the sky on.
+export const TOTAL_MS = 45 * 60_000;
 
 export const started = Date.now();
 export const log = (msg) => console.log(`[e2e ${((Date.now() - started) / 1000).toFixed(1)}s] ${msg}`);
@@ -95,6 +105,8 @@ export async function run(cmd, args, ms) {
 export const results = [];
 /** PMC_E2E_ONLY: a comma-separated list of step numbers to run alone, while working on them. */
 const ONLY = process.env.PMC_E2E_ONLY ? new Set(process.env.PMC_E2E_ONLY.split(',').map((x) => x.trim())) : null;
+/** Whether step 16, the README's gallery, runs (PMC_E2E_GALLERY=1, or PMC_E2E_ONLY naming it). */
+export const GALLERY = process.env.PMC_E2E_GALLERY === '1' || (ONLY?.has('16') ?? false);
 export async function step(name, fn) {
   if (ONLY && !ONLY.has(name.split('.')[0])) return;
   const t0 = Date.now();

@@ -13,8 +13,11 @@
 //   PMC_E2E_DIRECT=1  load the page from `pmc serve` itself even when its embedded viewer is
 //                   older than viewer/dist (by default such a binary's API is used behind a small
 //                   front server that serves the fresh viewer/dist)
-//   PMC_E2E_DEM     the elevation model step 11 imports (default: pmc-dem's ETOPO60 fixture)
+//   PMC_E2E_DEM     the elevation model steps 11, 14 and 15 import (default: NOAA's ETOPO5 of
+//                   Debian's ferret-datasets where installed, else pmc-dem's ETOPO60 fixture)
 //   PMC_E2E_IMAGERY an image step 11 drapes over it (default: none)
+//   PMC_E2E_GALLERY=1  also step 16, the README's gallery (pictures with the sky: see
+//                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
 //
@@ -29,10 +32,11 @@
 import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { openBrowser } from './browser.mjs';
-import { CHROMIUM, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, short, started, step } from './harness.mjs';
+import { CHROMIUM, GALLERY, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, short, started, step } from './harness.mjs';
 import * as closeup from './scenarios/closeup.mjs';
 import * as editing from './scenarios/editing.mjs';
 import * as elevationModel from './scenarios/elevationModel.mjs';
+import * as gallery from './scenarios/gallery.mjs';
 import * as imagery from './scenarios/imagery.mjs';
 import * as levelSwitch from './scenarios/levelSwitch.mjs';
 import * as lodDefault from './scenarios/lodDefault.mjs';
@@ -81,6 +85,8 @@ async function main() {
   }
 
   for (const s of REAL_SERVER_SCENARIOS) await step(s.name, () => s.scenario(t));
+  // the README's pictures: asked for (PMC_E2E_GALLERY=1, or PMC_E2E_ONLY naming step 16)
+  if (GALLERY) await step(gallery.name, () => gallery.scenario(t));
 }
 
 try {

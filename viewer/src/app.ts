@@ -413,6 +413,8 @@ export class App implements TestHookTarget {
       this.pathActive = false;
       this.editChanged = true;
     }
+    // the tool bar shows the choice at once, not at the next animation frame
+    this.panels(this.params !== null);
   }
 
   /** The Path tool: the left button picks the start, then the goal. No world needed. */
@@ -420,6 +422,7 @@ export class App implements TestHookTarget {
     this.editor.setTool('look');
     this.pathActive = true;
     this.editChanged = true;
+    this.panels(this.params !== null);
   }
 
   setNavGrid(on: boolean): void {

@@ -5,7 +5,7 @@
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
-import { PMC_BIN, VIEWPORT, check, cleanups, log, run, viewerDir } from '../harness.mjs';
+import { DEM_SOURCE, PMC_BIN, VIEWPORT, check, cleanups, log, run } from '../harness.mjs';
 import { crop, fractionDifferent } from '../images.mjs';
 import { flaggedPixels } from '../lodFlight.mjs';
 import { startBackend } from '../servers.mjs';
@@ -17,9 +17,9 @@ export const name = '11. a real planet from an elevation model: imported, seen f
 
 export async function scenario(t) {
   const { page, consoleProblems, failedResponses, hook, ready, waitFor, shot } = t;
-  // PMC_E2E_DEM: another equirectangular model to fly over (the README's pictures are taken
-  // over ETOPO5); by default the one-degree ETOPO60 fixture of pmc-dem's tests
-  const source = process.env.PMC_E2E_DEM ? resolve(process.env.PMC_E2E_DEM) : resolve(viewerDir, '../crates/pmc-dem/tests/fixtures/etopo60.cdf');
+  // ETOPO5 where installed (the README's pictures are taken over it), or PMC_E2E_DEM, or the
+  // one-degree ETOPO60 fixture of pmc-dem's tests (harness.mjs)
+  const source = DEM_SOURCE;
   const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-dem-'));
   cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
   const dem = join(dir, 'earth.pmcdem');

@@ -1,20 +1,21 @@
 // Step 14: colour by place, not by mesh: at the same view with lighting off, forcing the terrain
 // to level L and then to level L + 1 changes its colour by at most ΔE 3 (CIE76) at the land places
-// where the two levels' surfaces meet, on an elevation model; on the default planet (earthlike,
+// where the two levels' surfaces meet, on the earth preset from 100 km and on an elevation model
+// (ETOPO5 where installed) from 2 500 km; on the default planet (earthlike,
 // 1.9 km to the sea, a shore band 3 m high) at most 15 % of them differ by more (see SHARE_OVER),
 // the median by at most 0.5.
 
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
-import { PMC_BIN, check, cleanups, log, run, viewerDir } from '../harness.mjs';
+import { join } from 'node:path';
+import { DEM_SOURCE, PMC_BIN, check, cleanups, log, run } from '../harness.mjs';
 import { colourAt, quantile, visiblePlaces } from '../places.mjs';
 import { startBackend } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
 
 const { deltaE76 } = await viewerModule('colour.ts');
 
-export const name = '14. colour by place: the same view at levels L and L + 1 differs by at most ΔE 3 on land (lighting off), on earthlike and an elevation model';
+export const name = '14. colour by place: the same view at levels L and L + 1 differs by at most ΔE 3 on land (lighting off), on earthlike, the earth preset and an elevation model (ETOPO5)';
 
 /** Largest ΔE allowed at a place (CIE76). */
 export const MAX_DELTA_E = 3;
@@ -72,6 +73,14 @@ export async function compareLevels(t, label, cam, fine, minHeight, tolerance) {
   return des;
 }
 
+/** The level most chunks of the view `cam` have when the selection is left to itself. */
+async function naturalLevel(t, label, cam) {
+  await t.hook((c) => window.__pmc.setCamera(...c), cam);
+  const natural = await t.ready(label);
+  const counts = [...natural.lod.levelsText.matchAll(/L(\d+) (\d+)/g)].map((m) => [Number(m[1]), Number(m[2])]);
+  return counts.sort((a, b) => b[1] - a[1])[0][0];
+}
+
 export async function scenario(t) {
   const { page, hook, consoleProblems, failedResponses } = t;
   // the default planet (earthlike, seed 7) from orbit
@@ -87,8 +96,20 @@ export async function scenario(t) {
   await hook(() => window.__pmc.debug({ lighting: true }));
   await page.goto('about:blank');
   await server.stop();
+  // the earth preset at true scale: a mountain range with snow, rock and forest from 100 km
+  const earth = await startBackend(null, { extra: ['--preset', 'earth'] });
+  await page.goto(`${earth.url}#preset=earth&seed=7&mode=orbit&lat=39&lon=0`, { waitUntil: 'load', timeout: 60_000 });
+  await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+  await hook(() => window.__pmc.mode('orbit'));
+  const earthCam = [39, 0, 100_000, 0, -90];
+  const earthLevel = await naturalLevel(t, 'the earth preset from 100 km', earthCam);
+  results.push([`earth ${earthLevel}-${earthLevel + 1}`, 0, await compareLevels(t, 'levels-earth', earthCam, earthLevel, 1, 5)]);
+  await hook((d) => window.__pmc.lod(d), detail);
+  await hook(() => window.__pmc.debug({ lighting: true }));
+  await page.goto('about:blank');
+  await earth.stop();
   // an elevation model (by default the one-degree ETOPO60 fixture) over the Himalaya
-  const source = process.env.PMC_E2E_DEM ? resolve(process.env.PMC_E2E_DEM) : resolve(viewerDir, '../crates/pmc-dem/tests/fixtures/etopo60.cdf');
+  const source = DEM_SOURCE;
   const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-levels-'));
   cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
   const dem = join(dir, 'earth.pmcdem');
@@ -99,10 +120,7 @@ export async function scenario(t) {
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
   await hook(() => window.__pmc.mode('orbit'));
   // the level most chunks of the view have, and the next coarser one
-  await hook(() => window.__pmc.setCamera(29, 86, 2_500_000, 0, -90));
-  const natural = await t.ready('the elevation model over the Himalaya');
-  const counts = [...natural.lod.levelsText.matchAll(/L(\d+) (\d+)/g)].map((m) => [Number(m[1]), Number(m[2])]);
-  const demLevel = counts.sort((a, b) => b[1] - a[1])[0][0];
+  const demLevel = await naturalLevel(t, 'the elevation model over the Himalaya', [29, 86, 2_500_000, 0, -90]);
   results.push([`dem ${demLevel}-${demLevel + 1}`, 0, await compareLevels(t, 'levels-dem', [29, 86, 2_500_000, 0, -90], demLevel, 10, 5)]);
   await hook((d) => window.__pmc.lod(d), detail);
   await hook(() => window.__pmc.debug({ lighting: true }));

@@ -101,6 +101,8 @@ export async function scenario(t) {
   check((await hook(() => window.__pmc.stats())).pathTool, 'stats() does not say the Path tool is chosen');
   const [A, B] = [[CX - 100, CY + 40], [CX + 100, CY - 20]];
   await page.mouse.click(...A);
+  // (the click is taken by the next animation frame)
+  await waitFor(page, 'the start of the path', () => window.__pmc.path().phase !== 'empty', null, pathState, 10_000);
   const p1 = await hook(() => window.__pmc.path());
   check(p1.phase === 'start' && p1.from !== null, `after the first click: ${p1.phase} (${p1.message})`);
   await page.mouse.click(...B);
