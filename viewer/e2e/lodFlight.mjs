@@ -52,9 +52,9 @@ export function levelRange(levels) {
 }
 
 /**
- * Flies down over (`lat`, `lon`) through `stops` (`{ name, height }`: metres above the ground, the
- * first from orbit looking at the planet's centre, the others looking north 15° below the
- * horizon), then looking straight down at the heights of `zoom` (metres above the ground, down
+ * Flies down over (`lat`, `lon`) through `stops` (`{ name, height, pitch }`: metres above the
+ * ground, the first from orbit looking at the planet's centre, the others looking north `pitch`
+ * degrees, by default 15° below the horizon), then looking straight down at the heights of `zoom` (metres above the ground, down
  * and back up), checking each as the file header says, and the pictures on the way of the zoom.
  * `t` is the harness: `{ page, hook, ready, shot, log, check, problems }`, `problems()` giving the
  * console errors and failed responses so far. Screenshots are `${label}-${stop}.png` (flagged) and,
@@ -100,7 +100,7 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
       ground = s.alt - s.aboveGround;
     }
     await hook(() => window.__pmc.mode('fly'));
-    const pitch = stop.down ? -90 : -15;
+    const pitch = stop.down ? -90 : (stop.pitch ?? -15);
     await hook(([a, b, h, p]) => window.__pmc.setCamera(a, b, h, 0, p), [lat, lon, ground + stop.height, pitch]);
   };
   /** Measures the ground under the camera again (from the chunks shown); returns the height above it. */

@@ -1,7 +1,8 @@
 // Step 16 (with PMC_E2E_GALLERY=1, or PMC_E2E_ONLY=16): the README's gallery, as a user sees
 // each view with the sky on: the default planet, the earth preset and the real Earth (ETOPO5
-// with NASA's Visible Earth where installed) from orbit, 100 km (the default planet: 1 km), 10 km
-// (100 m), 100 m (10 m) and 2 m above the ground, and a sunset from the ground. Each descent is
+// with NASA's Visible Earth where installed, over the Bay of Naples) from orbit, 100 km (the
+// default planet: 1 km), 10 km (100 m), 100 m (10 m) and 2 m above the ground, and a sunset from
+// 30 m over the ground. Each descent is
 // the levels-of-detail flight of steps 9 and 10 (no crack, no hole at any stop); the pictures
 // are e2e/artifacts/gallery-*-view.png and gallery-*-sunset.png.
 
@@ -17,7 +18,10 @@ export const name = '16. the gallery: the default planet, the earth preset and t
 /** NASA's Visible Earth of Debian's xplanet-images. */
 const EARTH_JPG = '/usr/share/xplanet/images/earth.jpg';
 
-/** Flies down over (`lat`, `lon`) through `stops`, then looks toward a sun 2° over the horizon. */
+/**
+ * Flies down over (`lat`, `lon`) through `stops`, then, 30 m over the last stop, looks toward a
+ * sun 2° over the horizon.
+ */
 async function descent(t, label, lat, lon, stops) {
   const { hook, ready, shot } = t;
   await hook(() => window.__pmc.sky({ atmosphere: true, sunAzimuth: 135, sunElevation: 40 }));
@@ -25,7 +29,7 @@ async function descent(t, label, lat, lon, stops) {
   // the sunset: at the last stop, the camera turned west a little above the horizon, the sun
   // 2° over the horizon ahead
   const s = await hook(() => window.__pmc.stats());
-  await hook(([a, b, h]) => window.__pmc.setCamera(a, b, h, 270, 4), [lat, lon, s.alt]);
+  await hook(([a, b, h]) => window.__pmc.setCamera(a, b, h, 270, 4), [lat, lon, s.alt + 30]);
   await hook(() => window.__pmc.sky({ atmosphere: true, sunAzimuth: 270, sunElevation: 2 }));
   await ready(`${label} at sunset`);
   await shot(`${label}-sunset`);
@@ -34,22 +38,27 @@ async function descent(t, label, lat, lon, stops) {
 
 export async function scenario(t) {
   const { page, hook } = t;
-  const stops = (heights) => [{ name: 'orbit', height: heights[0], orbit: true }, ...heights.slice(1).map((h) => ({ name: `${h}m`, height: h }))];
+  // (on the small default planet the horizon lies 49° below it from 1 km: that stop looks down more)
+  const stops = (heights, pitches = {}) => [
+    { name: 'orbit', height: heights[0], orbit: true },
+    ...heights.slice(1).map((h) => ({ name: `${h}m`, height: h, pitch: pitches[h] ?? -15 })),
+  ];
 
   // the default planet (earthlike, seed 7: 1.9 km to the sea)
   await page.goto(`${t.shared.pageBase}#preset=earthlike&seed=7&mode=orbit&lat=-10&lon=8`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined && window.__pmc.stats().preset === 'earthlike', null, { timeout: 60_000 });
-  await descent(t, 'gallery-earthlike', -10, 8, stops([6000, 1000, 100, 10, 2]));
+  await descent(t, 'gallery-earthlike', -10, 8, stops([6000, 1000, 100, 10, 2], { 1000: -60 }));
 
-  // the earth preset at true scale over a mountain range
+  // the earth preset at true scale: low land near the equator, 140 m above the sea
   const earth = await startBackend(null, { extra: ['--preset', 'earth'] });
-  await page.goto(`${earth.url}#preset=earth&seed=7&mode=orbit&lat=39&lon=0`, { waitUntil: 'load', timeout: 60_000 });
+  await page.goto(`${earth.url}#preset=earth&seed=7&mode=orbit&lat=5&lon=100`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
-  await descent(t, 'gallery-earth', 39, 0, stops([12_000_000, 100_000, 10_000, 100, 2]));
+  await descent(t, 'gallery-earth', 5, 100, stops([12_000_000, 100_000, 10_000, 100, 2]));
   await page.goto('about:blank');
   await earth.stop();
 
-  // the real Earth: ETOPO5 (where installed) with NASA's picture draped over it, the Himalaya
+  // the real Earth: ETOPO5 (where installed) with NASA's picture draped over it, the Bay of
+  // Naples
   const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-gallery-'));
   cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
   const dem = join(dir, 'earth.pmcdem');
@@ -61,9 +70,9 @@ export async function scenario(t) {
   if (existsSync(EARTH_JPG)) extra.push('--imagery', join(dir, 'earth.pmcimg'));
   log(`  the real Earth: ${DEM_SOURCE}${existsSync(EARTH_JPG) ? ` with ${EARTH_JPG}` : ''}`);
   const real = await startBackend(null, { extra });
-  await page.goto(`${real.url}#mode=orbit&lat=28&lon=86.9`, { waitUntil: 'load', timeout: 60_000 });
+  await page.goto(`${real.url}#mode=orbit&lat=40.85&lon=14.3`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
-  await descent(t, 'gallery-dem', 28, 86.9, stops([12_000_000, 100_000, 10_000, 100, 2]));
+  await descent(t, 'gallery-dem', 40.85, 14.3, stops([12_000_000, 100_000, 10_000, 100, 2]));
   await hook(() => window.__pmc.sky({ atmosphere: false }));
   await page.goto('about:blank');
   await real.stop();
