@@ -40,6 +40,20 @@ float pmcFbm(vec3 p) {
 }
 `;
 
+/**
+ * The terrain's logarithmic depth (three.js's, for a perspective camera), its varying sampled at
+ * the centroid of the samples a triangle covers, not at the pixel's centre: with antialiasing a
+ * fragment writes one depth for all its samples, and at a silhouette seen at a grazing angle the
+ * depth extrapolated to the pixel's centre lay far off the triangle, so the sky or the far side of
+ * a ridge won samples of the pixels along it (dark dots along the silhouettes of small relief
+ * from 10 km, `docs/images/earth-10km.png`).
+ */
+const LOG_DEPTH_PARS = /* glsl */ `
+#ifdef USE_LOGARITHMIC_DEPTH_BUFFER
+centroid varying float vFragDepth;
+#endif
+`;
+
 /** Cells of the noise lattice per period: the period in metres is NOISE_PERIOD_CELLS / frequency. */
 export const NOISE_PERIOD_CELLS = 289;
 
@@ -90,7 +104,7 @@ varying vec3 vUp;
 varying vec3 vRel;
 varying vec3 vDetailPos;
 #include <common>
-#include <logdepthbuf_pars_vertex>
+${LOG_DEPTH_PARS}
 void main() {
   // relative to the eye from the high and low parts, not modelMatrix * position: every copy of
   // a border vertex (one place, chunks of other origins) then lands on the same bits
@@ -104,7 +118,9 @@ void main() {
   vNoisePos = (uOriginMod + position) * uNoiseFreq;
   vUp = normalize(uOrigin + position);
   gl_Position = projectionMatrix * viewMatrix * world;
-  #include <logdepthbuf_vertex>
+  #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
+  vFragDepth = 1.0 + gl_Position.w;
+  #endif
 }
 `;
 
@@ -151,7 +167,10 @@ varying vec3 vUp;
 varying vec3 vRel;
 varying vec3 vDetailPos;
 #include <common>
-#include <logdepthbuf_pars_fragment>
+${LOG_DEPTH_PARS}
+#ifdef USE_LOGARITHMIC_DEPTH_BUFFER
+uniform float logDepthBufFC;
+#endif
 ${NOISE}
 ${SEA_SURFACE}
 ${ATMOSPHERE_GLSL}
@@ -251,11 +270,15 @@ vec4 pmcImagery(vec3 up) {
   return vec4(c, inside);
 }
 void main() {
-  #include <logdepthbuf_fragment>
+  #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
+  gl_FragDepth = log2(vFragDepth) * logDepthBufFC * 0.5;
+  #endif
   if (uBackfaceFlag > 0.5 && !gl_FrontFacing) {
-    #ifdef USE_LOGDEPTHBUF
+    #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
     // 0.2 % farther: where a back face meets a front face at a silhouette (the same edge, the
-    // same depth) the front face wins; the inside seen through a crack is far behind anyway
+    // same depth) the front face wins; the inside seen through a crack is far behind anyway.
+    // (three.js's define; under its former name, USE_LOGDEPTHBUF, this offset was compiled out
+    // and back faces won half the samples along every silhouette in the test mode)
     gl_FragDepth = min(1.0, gl_FragDepth + log2(1.002) * logDepthBufFC * 0.5);
     #endif
     gl_FragColor = vec4(1.0, 0.0, 1.0, 1.0);

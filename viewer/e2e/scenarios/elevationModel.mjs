@@ -7,7 +7,7 @@ import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { DEM_SOURCE, PMC_BIN, VIEWPORT, check, cleanups, log, run } from '../harness.mjs';
 import { crop, fractionDifferent } from '../images.mjs';
-import { flaggedPixels } from '../lodFlight.mjs';
+import { TINTED_ALLOWED, flaggedPixels, tintedPixels } from '../lodFlight.mjs';
 import { startBackend } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
 
@@ -80,9 +80,12 @@ export async function scenario(t) {
     await hook(() => window.__pmc.debug({ backfaces: true }));
     await hook(([a, b, h, p]) => window.__pmc.setCamera(a, b, h, 0, p), [lat, lon, height, pitch]);
     const st = await ready(name);
-    const flagged = flaggedPixels(await shot(`${name}-flagged`));
-    log(`  ${name}: ${st.shown} chunks shown, levels ${st.lod.levelsText}, ${flagged} flagged pixels`);
+    const flaggedImg = await shot(`${name}-flagged`);
+    const flagged = flaggedPixels(flaggedImg);
+    const tinted = tintedPixels(flaggedImg);
+    log(`  ${name}: ${st.shown} chunks shown, levels ${st.lod.levelsText}, ${flagged} flagged pixels, ${tinted} tinted`);
     check(flagged === 0, `${name}: ${flagged} flagged pixels (a crack or a hole): see ${name}-flagged.png`);
+    check(tinted <= TINTED_ALLOWED, `${name}: ${tinted} pixels tinted by the back-face flag: see ${name}-flagged.png`);
     await hook(() => window.__pmc.debug({ backfaces: false }));
     return shot(`${name}-view`);
   };
