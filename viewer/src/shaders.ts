@@ -338,8 +338,16 @@ void main() {
     float fog = 1.0 - exp(-length(vRel) / max(uFogDistance, 1.0));
     lit = mix(lit, uSkyColour, 0.35 * fog);
   }
-  // the terrain's final colour (linear RGB), before the output transform
-  vec3 pmcColour = pmcAerialPerspective(lit, vRel); // atmosphere.ts: off without air and in test modes
+  // the terrain's final colour (linear RGB), before the output transform, seen through the air
+  // (atmosphere.ts: off without air and in test modes) at the place's own height over the sphere,
+  // the sea's surface over ground below it: between the vertices of a coarse chunk the triangle
+  // (a chord) sags kilometres under the sphere when seen from orbit (1.8 km at the middle of a
+  // 300 km tile), and the denser air that deep drew the mesh's grid into the haze
+  vec3 eye = uAtmoUp * (uAtmoR + uAtmoCamH);
+  vec3 place = eye + vRel;
+  float surface = (underwater && uWater > 0.5) ? 0.0 : h;
+  vec3 seen = normalize(place) * (uDatum + surface) - eye;
+  vec3 pmcColour = pmcAerialPerspective(lit, seen);
   gl_FragColor = vec4(pmcColour, 1.0);
   #include <colorspace_fragment>
 }
