@@ -113,6 +113,8 @@ export class PlanetScene {
     uBackfaceFlag: { value: 0 },
   };
   private params: PlanetParams | null = null;
+  /** The camera of the last `place` (planet frame): where a chunk added since is placed at once. */
+  private camera: V3 | null = null;
   private flags: DebugFlags = {
     wireframe: false,
     faceColours: false,
@@ -396,6 +398,14 @@ export class PlanetScene {
     };
     this.chunks.set(key, obj);
     this.terrainGroup.add(mesh);
+    // placed at once: a chunk added after this frame's `place` kept the render origin until the
+    // next one, and three.js's frustum culling dropped it from the frame that drew it; with
+    // render on demand no later frame drew it again (a hole over the sea disk)
+    if (this.camera) {
+      const rel = relativeToCamera(origin, this.camera);
+      mesh.position.set(rel[0], rel[1], rel[2]);
+      mesh.updateMatrixWorld();
+    }
     this.changes++;
     if (this.flags.borders) this.addBorders(obj, chunk.indices, chunk.vertexCount);
   }
@@ -474,6 +484,7 @@ export class PlanetScene {
 
   /** Floating origin: places every object relative to the camera (f64 in, small f32 out). */
   place(camera: V3): void {
+    this.camera = [camera[0], camera[1], camera[2]];
     const eye = splitHighLow(camera);
     this.shared.uEyeHigh.value.set(...eye.high);
     this.shared.uEyeLow.value.set(...eye.low);
