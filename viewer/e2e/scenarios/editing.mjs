@@ -109,7 +109,8 @@ export async function scenario(t) {
   // (right of the tools panel, which covers the bottom left up to x = 370)
   await A.mouse.click(CX - 90, CY + 50);
   await A.mouse.click(CX + 150, CY - 50);
-  await waitFor(A, 'A: the path', () => !['start', 'loading'].includes(window.__pmc.path().phase), null, pathState);
+  // (the clicks are taken by the next animation frame: the path is empty until then)
+  await waitFor(A, 'A: the path', () => !['empty', 'start', 'loading'].includes(window.__pmc.path().phase), null, pathState);
   const pathA0 = await hA(() => window.__pmc.path());
   check(pathA0.phase === 'found' && pathA0.revision === rev0, `A: no path across the close-up before the dig: ${pathA0.phase} (${pathA0.message}), revision ${pathA0.revision}`);
   await hA(() => window.__pmc.navgrid(true));

@@ -106,7 +106,7 @@ export async function scenario(t) {
   const p1 = await hook(() => window.__pmc.path());
   check(p1.phase === 'start' && p1.from !== null, `after the first click: ${p1.phase} (${p1.message})`);
   await page.mouse.click(...B);
-  await waitFor(page, 'the path', () => !['start', 'loading'].includes(window.__pmc.path().phase), null, pathState);
+  await waitFor(page, 'the path', () => !['empty', 'start', 'loading'].includes(window.__pmc.path().phase), null, pathState);
   const p = await hook(() => window.__pmc.path());
   log(`  ${p.from} -> ${p.to}: ${p.message}`);
   check(p.phase === 'found', `no path between two points of the close-up: ${p.phase}: ${p.message}`);
