@@ -402,8 +402,7 @@ export class PlanetScene {
     // next one, and three.js's frustum culling dropped it from the frame that drew it; with
     // render on demand no later frame drew it again (a hole over the sea disk)
     if (this.camera) {
-      const rel = relativeToCamera(origin, this.camera);
-      mesh.position.set(rel[0], rel[1], rel[2]);
+      placeChunk(obj, this.camera);
       mesh.updateMatrixWorld();
     }
     this.changes++;
@@ -489,10 +488,7 @@ export class PlanetScene {
     this.shared.uEyeHigh.value.set(...eye.high);
     this.shared.uEyeLow.value.set(...eye.low);
     const rel: V3 = [0, 0, 0];
-    for (const obj of this.chunks.values()) {
-      relativeToCamera(obj.origin, camera, rel);
-      obj.mesh.position.set(rel[0], rel[1], rel[2]);
-    }
+    for (const obj of this.chunks.values()) placeChunk(obj, camera, rel);
     this.placeSea(camera);
   }
 
@@ -624,4 +620,10 @@ export class PlanetScene {
     this.cursorBallMaterial.dispose();
     this.cursorRingMaterial.dispose();
   }
+}
+
+/** Floating origin: a chunk's mesh at (its origin - camera), computed in f64 (`rel`: scratch). */
+function placeChunk(obj: ChunkObject, camera: V3, rel: V3 = [0, 0, 0]): void {
+  relativeToCamera(obj.origin, camera, rel);
+  obj.mesh.position.set(rel[0], rel[1], rel[2]);
 }
