@@ -21,6 +21,8 @@ import { NavScene } from './navScene';
 import { PATH_TOOL, PathTool, type PathStatus } from './pathTool';
 import { planetParams, type PlanetParams } from './planetParams';
 import { parseImagery, loadImageryTexture, type ImageryInfo } from './imagery';
+import { parseRelief, type ReliefGrid } from './relief';
+import { loadReliefTexture } from './reliefTexture';
 import { PlanetScene, type DebugFlags } from './planetScene';
 import { Readiness } from './readiness';
 import {
@@ -51,6 +53,8 @@ export class App implements TestHookTarget {
   private pathActive = false;
   /** The imagery draped on the planet shown, if any. */
   private imageryTexture: THREE.Texture | null = null;
+  /** The relief of the planet shown (an elevation model's), if any. */
+  private reliefTexture: THREE.Texture | null = null;
   private pathDrawn = -1;
   private gridDrawn = -1;
   private navChanged = true;
@@ -214,15 +218,18 @@ export class App implements TestHookTarget {
       try {
         const info = await this.api.planet(choice);
         if (request !== this.planetRequest) return;
-        const imagery = await this.loadImagery(info);
+        const [imagery, relief] = await Promise.all([this.loadImagery(info), this.loadRelief(info)]);
         if (request !== this.planetRequest) {
           imagery.texture?.dispose();
+          relief.texture?.dispose();
           return;
         }
         this.applyPlanet(info);
         this.setImagery(imagery.texture, imagery.info);
+        this.setRelief(relief.texture, relief.grid);
         this.clearError();
         if (imagery.error) this.showError(`The planet's imagery is not shown: ${imagery.error}`);
+        else if (relief.error) this.showError(`The planet's relief is not used for its materials: ${relief.error}`);
         return;
       } catch (e) {
         if (request !== this.planetRequest) return;
@@ -249,6 +256,25 @@ export class App implements TestHookTarget {
     } catch (e) {
       return { texture: null, info: null, error: e instanceof Error ? e.message : String(e) };
     }
+  }
+
+  /** The planet's relief (`/planet`'s `relief` block and its grid), or why there is none. */
+  private async loadRelief(info: PlanetInfo): Promise<{ texture: THREE.Texture | null; grid: ReliefGrid | null; error: string | null }> {
+    try {
+      const relief = parseRelief(info);
+      if (!relief) return { texture: null, grid: null, error: null };
+      const max = this.renderer.capabilities.maxTextureSize;
+      const { texture, grid } = await loadReliefTexture(relief, document.baseURI, max);
+      return { texture, grid, error: null };
+    } catch (e) {
+      return { texture: null, grid: null, error: e instanceof Error ? e.message : String(e) };
+    }
+  }
+
+  private setRelief(texture: THREE.Texture | null, grid: ReliefGrid | null): void {
+    if (this.reliefTexture && this.reliefTexture !== texture) this.reliefTexture.dispose();
+    this.reliefTexture = texture;
+    this.scene.setRelief(texture, grid);
   }
 
   private setImagery(texture: THREE.Texture | null, info: ImageryInfo | null): void {

@@ -10,6 +10,7 @@ import type { DecodedChunk } from './chunkDecode';
 import { boundaryEdges } from './boundaryEdges';
 import { modPositive, relativeToCamera, splitHighLow, splitPositions, type V3 } from './frames';
 import { imageryCellMetres, type ImageryInfo } from './imagery';
+import { reliefCellMetres, type ReliefGrid } from './relief';
 import { materialUniforms } from './materials';
 import { pushUniform, pushUniforms } from './pictureKey';
 import type { PlanetParams } from './planetParams';
@@ -103,6 +104,11 @@ export class PlanetScene {
     uHasImagery: { value: 0 },
     uImageryExtent: { value: new THREE.Vector4(-Math.PI, Math.PI, -Math.PI / 2, Math.PI / 2) },
     uImageryCell: { value: 1 },
+    uRelief: { value: null as THREE.Texture | null },
+    uHasRelief: { value: 0 },
+    uReliefAxes: { value: new THREE.Vector4(-Math.PI, 1, -Math.PI / 2, 1) },
+    uReliefGrid: { value: new THREE.Vector4(1, 1, 0, 0) },
+    uReliefScale: { value: new THREE.Vector2(1, 1) },
     uWaterShallow: { value: new THREE.Vector3(0.55, 0.8, 0.85) },
     uWaterDeep: { value: new THREE.Vector3(0.01, 0.05, 0.14) },
     uWaterScale: { value: 10 },
@@ -125,6 +131,8 @@ export class PlanetScene {
   };
   /** A 1 x 1 stand-in for the imagery texture while a planet has none. */
   private readonly noImagery = new THREE.DataTexture(new Uint8Array([128, 128, 128, 255]), 1, 1);
+  /** A 1 x 1 stand-in for the relief texture while a planet has none. */
+  private readonly noRelief = new THREE.DataTexture(new Float32Array([0]), 1, 1, THREE.RedFormat, THREE.FloatType);
   private readonly borderMaterial = new THREE.LineBasicMaterial({
     color: 0xffee33,
     depthTest: true,
@@ -184,6 +192,8 @@ export class PlanetScene {
 
   constructor() {
     this.noImagery.needsUpdate = true;
+    this.noRelief.needsUpdate = true;
+    this.shared.uRelief.value = this.noRelief;
     this.scene.background = this.background;
     this.scene.add(this.terrainGroup);
     this.scene.add(this.atmosphere.sky);
@@ -275,6 +285,7 @@ export class PlanetScene {
     s.uWaterScale.value = params.waterScale;
     s.uNoiseFreq.value = params.noiseFreq;
     this.setImagery(null, null);
+    this.setRelief(null, null);
     this.syncFog();
     this.removeSea();
     if (params.seaRadius !== null) {
@@ -554,6 +565,25 @@ export class PlanetScene {
   }
 
   /**
+   * Takes the materials' heights from `texture` (the grid `grid` describes) where a pixel spans
+   * a good part of a data cell, or from the mesh alone when null. The texture is the caller's.
+   */
+  setRelief(texture: THREE.Texture | null, grid: ReliefGrid | null): void {
+    const s = this.shared;
+    if (!texture || !grid || !this.params) {
+      s.uRelief.value = this.noRelief;
+      s.uHasRelief.value = 0;
+      return;
+    }
+    const rad = Math.PI / 180;
+    s.uRelief.value = texture;
+    s.uHasRelief.value = 1;
+    s.uReliefAxes.value.set(grid.lonFirst * rad, grid.lonStep * rad, grid.latFirst * rad, grid.latStep * rad);
+    s.uReliefGrid.value.set(grid.width, grid.height, grid.wraps ? 1 : 0, (grid.clampSouth ? 1 : 0) + (grid.clampNorth ? 2 : 0));
+    s.uReliefScale.value.set(grid.scale, reliefCellMetres(grid, this.params.shape.datum));
+  }
+
+  /**
    * Up to `count` vertices of the chunks shown, spread evenly over them (test hook): where they
    * are, their height and the lowest height of the triangles around them.
    */
@@ -616,6 +646,7 @@ export class PlanetScene {
     this.seaMaterial.dispose();
     this.atmosphere.dispose();
     this.noImagery.dispose();
+    this.noRelief.dispose();
     this.borderMaterial.dispose();
     this.cursorBallMaterial.dispose();
     this.cursorRingMaterial.dispose();

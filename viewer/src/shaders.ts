@@ -158,6 +158,13 @@ uniform sampler2D uImagery;
 uniform float uHasImagery;
 uniform vec4 uImageryExtent; // west, east, south, north, radians (cell edges)
 uniform float uImageryCell;  // metres of one picture cell on the ground
+// an elevation model's relief (viewer/src/relief.ts): the materials' height where a pixel spans
+// a good part of a data cell, the same at every level of detail
+uniform sampler2D uRelief;   // one f32 channel, the data's metres, row 0 the southernmost
+uniform float uHasRelief;
+uniform vec4 uReliefAxes;    // longitude of column 0, between columns, latitude of row 0, between rows (radians)
+uniform vec4 uReliefGrid;    // columns, rows, wraps (1), rows clamped past the south (1) and north (2) edges
+uniform vec2 uReliefScale;   // metres of the planet per metre of the data, metres of a data cell on the ground
 varying vec3 vColor;
 varying float vHeight;
 varying float vWater;
@@ -269,6 +276,44 @@ vec4 pmcImagery(vec3 up) {
   vec3 c = textureGrad(uImagery, vec2(u, v), gx, gy).rgb;
   return vec4(c, inside);
 }
+// The relief's height (metres above the datum) at the unit direction up, bilinear in column and
+// row as relief.ts's reliefHeightAt; .y 1 on the grid, 0 off a regional one.
+vec2 pmcRelief(vec3 up) {
+  float lat = asin(clamp(up.y, -1.0, 1.0));
+  float lon = atan(up.x, up.z);
+  float w = uReliefGrid.x;
+  float h = uReliefGrid.y;
+  float x = mod(lon - uReliefAxes.x, 2.0 * PI) / uReliefAxes.y;
+  float y = (lat - uReliefAxes.z) / uReliefAxes.w;
+  float inside = 1.0;
+  float clampBits = uReliefGrid.w;
+  if (y < 0.0) {
+    if (mod(clampBits, 2.0) < 0.5 && y < -1e-3) inside = 0.0;
+    y = 0.0;
+  } else if (y > h - 1.0) {
+    if (clampBits < 1.5 && y > h - 1.0 + 1e-3) inside = 0.0;
+    y = h - 1.0;
+  }
+  if (uReliefGrid.z > 0.5) {
+    x = mod(x, w);
+  } else if (x > w - 1.0) {
+    if (x > w - 1.0 + 1e-3) inside = 0.0;
+    x = w - 1.0;
+  }
+  float c0 = min(floor(x), w - 1.0);
+  float r0 = min(floor(y), h - 1.0);
+  float c1 = uReliefGrid.z > 0.5 ? mod(c0 + 1.0, w) : min(c0 + 1.0, w - 1.0);
+  float r1 = min(r0 + 1.0, h - 1.0);
+  float fx = x - c0;
+  float fy = y - r0;
+  float s0 = texelFetch(uRelief, ivec2(int(c0), int(r0)), 0).r;
+  float s1 = texelFetch(uRelief, ivec2(int(c1), int(r0)), 0).r;
+  float n0 = texelFetch(uRelief, ivec2(int(c0), int(r1)), 0).r;
+  float n1 = texelFetch(uRelief, ivec2(int(c1), int(r1)), 0).r;
+  float south = mix(s0, s1, fx);
+  float north = mix(n0, n1, fx);
+  return vec2(mix(south, north, fy) * uReliefScale.x, inside);
+}
 void main() {
   #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
   gl_FragDepth = log2(vFragDepth) * logDepthBufFC * 0.5;
@@ -286,7 +331,6 @@ void main() {
   }
   vec3 n = normalize(vNormal);
   vec3 up = normalize(vUp);
-  float h = vHeight;
   float slope = dot(n, up);
   // The pixel's footprint, metres: its distance times the angle a pixel subtends (the change of
   // the view ray's direction from one pixel to the next, whatever the surface's orientation). It
@@ -294,6 +338,15 @@ void main() {
   // the same colour at every level of detail.
   vec3 ray = normalize(vRel);
   float metresPerPixel = length(vRel) * max(length(dFdx(ray)), length(dFdy(ray)));
+  // The height the materials and the sea go by: the mesh's, or, where a pixel spans more than a
+  // few hundredths of a data cell, the elevation model's relief at the place (the same at every
+  // level, where a coarse chunk's triangles pass hundreds of metres under a finer one's peaks)
+  float h = vHeight;
+  if (uHasRelief > 0.5) {
+    vec2 relief = pmcRelief(up);
+    float far = smoothstep(0.03, 0.25, metresPerPixel / max(uReliefScale.y, 1e-3));
+    h = mix(h, relief.x, far * relief.y);
+  }
   // the place's noises: fixed frequencies of the planet, filtered by the pixel's footprint
   float meso = pmcFiltered(vNoisePos, 6, metresPerPixel * uNoiseFreq);
   float jit = 2.0 * (pmcFiltered(vNoisePos * 0.25 + 31.0, 3, 0.25 * metresPerPixel * uNoiseFreq) - 0.5) * 2.0;

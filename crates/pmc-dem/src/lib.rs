@@ -109,7 +109,7 @@ pub use png16::PngExtent;
 pub mod fuzz;
 
 pub use cube::{import_cube, CubeDem, DetailNoise, ImportOptions, ImportReport, Interpolation};
-pub use cube::{FormatChoice, StorageRow, DEFAULT_RADIUS};
+pub use cube::{FormatChoice, SourceAxes, StorageRow, DEFAULT_RADIUS};
 pub use dem::{DemStats, EquirectDem};
 pub use error::DemError;
 pub use header::MAX_HEADER_BYTES;

@@ -207,6 +207,47 @@ fn heights_are_the_same_bits_at_every_lattice_resolution_and_in_batches() {
     }
 }
 
+#[test]
+fn the_source_grid_read_with_a_stride_holds_the_stored_samples() {
+    // a tile size that the grid's sides do not divide, so the last tiles are partial
+    let dem = etopo60();
+    let out = dir("decimated").join("kept.pmcdem");
+    let options = ImportOptions {
+        level: Some(5),
+        tile_size: 48,
+        ..ImportOptions::default()
+    };
+    import_cube(&dem, &out, &options, &|_, _| {}).unwrap();
+    let cube = CubeDem::open(&out).unwrap();
+    let axes = cube.source_axes().unwrap();
+    assert_eq!((axes.width, axes.height, axes.wraps), (360, 180, true));
+    assert_eq!((axes.lon_step, axes.lat_step), (dem.lon_step(), dem.lat_step()));
+    assert_eq!((axes.lon_first, axes.lat_first), (dem.lon_first(), dem.lat_first()));
+    for stride in [1, 2, 7, 64, 500] {
+        let (w, h, values) = cube.source_decimated(stride).unwrap();
+        assert_eq!(
+            (w, h),
+            (360u32.div_ceil(stride), 180u32.div_ceil(stride)),
+            "stride {stride}"
+        );
+        assert_eq!(values.len(), (w * h) as usize);
+        for r in 0..h {
+            for c in 0..w {
+                let want = cube.source_sample(c * stride, r * stride).unwrap();
+                assert_eq!(
+                    values[(r * w + c) as usize].to_bits(),
+                    want.to_bits(),
+                    "stride {stride} ({c}, {r})"
+                );
+            }
+        }
+    }
+    assert!(matches!(cube.source_decimated(0), Err(DemError::OutOfGrid { .. })));
+    let v1 = CubeDem::open(fixture_dir().join(V1_FIXTURE)).unwrap();
+    assert!(v1.source_axes().is_none());
+    assert!(matches!(v1.source_decimated(1), Err(DemError::OutOfGrid { .. })));
+}
+
 /// `etopo60.cdf` imported at level 6 by the version 1 importer (`pmcdem-v1.md`), kept to check
 /// that version 1 files still open and give their heights as before.
 const V1_FIXTURE: &str = "etopo60_l6_v1.pmcdem";

@@ -92,6 +92,7 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
         "materials": t.materials,
         "palette": { "a": t.blend_colors[0], "b": t.blend_colors[1] },
         "imagery": crate::imagery_api::planet_field(&state, *id == state.config().terrain),
+        "relief": crate::relief_api::planet_field(&state, &t.spec, t.sea_radius),
         "edit": crate::edit_api::edit_info(&state, id),
     });
     Ok(json_response(v, "no-cache"))
@@ -229,7 +230,7 @@ pub async fn stats(State(state): State<AppState>) -> Response {
 pub async fn not_found(uri: Uri) -> ApiError {
     ApiError::not_found(format!(
         "no such API endpoint: {}; see docs/specs/http-api-v1.md (GET /api/v1/health, /planet, /chunks, \
-         /chunk/FACE/LEVEL/I/J/K, /stats, /imagery, /edits, /events, /path, /navgrid; POST /api/v1/edits, /edits/undo, \
+         /chunk/FACE/LEVEL/I/J/K, /stats, /imagery, /relief, /edits, /events, /path, /navgrid; POST /api/v1/edits, /edits/undo, \
          /edits/redo)",
         uri.path()
     ))

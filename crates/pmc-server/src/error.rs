@@ -50,6 +50,9 @@ pub enum ServerError {
     /// The imagery file could not be read (missing, damaged, not a `.pmcimg` file).
     #[error(transparent)]
     Imagery(#[from] pmc_imagery::ImageryError),
+    /// The elevation model's file could not be read for its relief.
+    #[error(transparent)]
+    Dem(#[from] pmc_dem::DemError),
     /// Serving failed after start.
     #[error("the server stopped: {0}")]
     Io(#[from] std::io::Error),

@@ -93,7 +93,7 @@ pub(crate) fn planet_field(state: &AppState, is_default_planet: bool) -> Value {
 }
 
 /// Whether an `If-None-Match` header value names `etag` (or is `*`).
-fn matches_etag(headers: &HeaderMap, etag: &str) -> bool {
+pub(crate) fn matches_etag(headers: &HeaderMap, etag: &str) -> bool {
     headers
         .get_all(header::IF_NONE_MATCH)
         .iter()

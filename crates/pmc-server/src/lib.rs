@@ -38,6 +38,7 @@ pub mod imagery_api;
 pub mod nav_api;
 mod planets;
 mod rate;
+pub mod relief_api;
 mod request;
 mod server;
 mod state;

@@ -1,6 +1,6 @@
 //! The router, listening, and shutdown.
 
-use crate::{api, assets, edit_api, imagery_api, nav_api, AppState, ServerConfig, ServerError};
+use crate::{api, assets, edit_api, imagery_api, nav_api, relief_api, AppState, ServerConfig, ServerError};
 use axum::extract::Request;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
@@ -50,6 +50,7 @@ pub fn router(state: AppState) -> Router {
         .route("/api/v1/chunk/{face}/{level}/{i}/{j}/{k}", get(api::chunk))
         .route("/api/v1/stats", get(api::stats))
         .route(imagery_api::IMAGERY_PATH, get(imagery_api::imagery))
+        .route(relief_api::RELIEF_PATH, get(relief_api::relief))
         .route("/api/v1/edits", get(edit_api::list).post(edit_api::post_edit))
         .route("/api/v1/edits/undo", post(edit_api::undo))
         .route("/api/v1/edits/redo", post(edit_api::redo))

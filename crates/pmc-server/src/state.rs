@@ -23,6 +23,8 @@ struct Inner {
     editing: Option<Arc<Editing>>,
     /// The imagery draped on the default planet, if any.
     imagery: Option<Arc<crate::imagery_api::ServedImagery>>,
+    /// The relief of the default planet when it is an elevation model's.
+    relief: Option<Arc<crate::relief_api::ServedRelief>>,
     /// Navigation grids recently used, most recent last.
     navs: std::sync::Mutex<std::collections::VecDeque<NavEntry>>,
     /// Set when the server begins to stop: long-lived answers (the event streams) end.
@@ -160,6 +162,7 @@ impl AppState {
                 Some(Arc::new(editing))
             }
         };
+        let relief = crate::relief_api::ServedRelief::of(&config.terrain)?.map(Arc::new);
         // A height-field planet brings its own (patch) layout: built now, kept as the server's.
         let heightfield = match config.mesher {
             crate::config::Mesher::Heightfield => {
@@ -190,6 +193,7 @@ impl AppState {
                 generator: Arc::new(generator),
                 editing,
                 imagery,
+                relief,
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
                 lod_errors: std::sync::Mutex::new(std::collections::HashMap::new()),
                 stopping: tokio::sync::watch::Sender::new(false),
@@ -242,6 +246,11 @@ impl AppState {
     /// The imagery draped on the default planet, if the server has one.
     pub fn imagery(&self) -> Option<&Arc<crate::imagery_api::ServedImagery>> {
         self.inner.imagery.as_ref()
+    }
+
+    /// The relief of the default planet, if it is an elevation model's that keeps its source grid.
+    pub fn relief(&self) -> Option<&Arc<crate::relief_api::ServedRelief>> {
+        self.inner.relief.as_ref()
     }
 
     /// The world being edited, if the server has one.

@@ -11,7 +11,8 @@ import { TINTED_ALLOWED, flaggedPixels, tintedPixels } from '../lodFlight.mjs';
 import { startBackend } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
 
-const { positionFromLatLon } = await viewerModule('frames.ts');
+const { latLonFromPosition, positionFromLatLon } = await viewerModule('frames.ts');
+const { parseRelief, gridAtStride, reliefHeightAt } = await viewerModule('relief.ts');
 
 export const name = '11. a real planet from an elevation model: imported, seen from orbit and near the ground with no crack or hole, land, shelf and deep ocean told apart, a cave dug under a mountain; the same model as a height field';
 
@@ -48,17 +49,29 @@ export async function scenario(t) {
   await hook(() => window.__pmc.setCamera(30, 127, 3_000_000, 0, -90));
   await ready('over the East China Sea');
   const view = await shot('dem-shelf-view');
-  // every 16th pixel: what lies under it (the height of the ground the ray meets) and its colour
-  const samples = await hook(([w, h, sea]) => {
+  // the data: the elevation model's source grid, as the server serves it (/api/v1/relief)
+  const reliefInfo = parseRelief(planet);
+  check(reliefInfo !== null, `the planet of an elevation model has no relief: ${JSON.stringify(planet.relief)}`);
+  const reliefGrid = gridAtStride(reliefInfo, 1);
+  const reliefValues = new Float32Array(await (await fetch(new URL(reliefInfo.url, server.url))).arrayBuffer());
+  check(reliefValues.length === reliefGrid.width * reliefGrid.height, `the relief holds ${reliefValues.length} values`);
+  // every 16th pixel: what lies under it (the data's height where the ray meets the ground) and
+  // its colour
+  const hits = await hook(([w, h]) => {
     const out = [];
     for (let y = 8; y < h; y += 16) {
       for (let x = 8; x < w; x += 16) {
         const hit = window.__pmc.pick(x, y);
-        if (hit) out.push({ x, y, h: Math.hypot(...hit.point) - sea });
+        if (hit) out.push({ x, y, point: hit.point });
       }
     }
     return out;
-  }, [VIEWPORT.width, VIEWPORT.height, planet.sea_radius]);
+  }, [VIEWPORT.width, VIEWPORT.height]);
+  const samples = hits.flatMap(({ x, y, point }) => {
+    const { lat, lon } = latLonFromPosition(point);
+    const h = reliefHeightAt(reliefGrid, reliefValues, lat, lon);
+    return h === null ? [] : [{ x, y, h }];
+  });
   const classes = { deep: [], shelf: [], land: [] };
   for (const p of samples) {
     const c = p.h < -1000 ? 'deep' : p.h < -10 && p.h > -180 ? 'shelf' : p.h > 50 ? 'land' : null;

@@ -27,6 +27,6 @@ pub use import::{
     centre_spacing_radians, default_level, import_cube, FormatChoice, ImportOptions, ImportReport,
     DEFAULT_MEMORY_BUDGET, DEFAULT_RADIUS, MAX_TILES,
 };
-pub use reader::{CubeDem, StorageRow, DEFAULT_CACHE_BYTES};
+pub use reader::{CubeDem, SourceAxes, StorageRow, DEFAULT_CACHE_BYTES};
 pub use sample::{Interpolation, MAX_LATTICE_RESOLUTION};
 pub use source_sample::SAMPLE_FADE_RADIUS;

@@ -50,6 +50,27 @@ struct Shard {
     bytes: usize,
 }
 
+/// The axes of the source grid a version 2 `.pmcdem` file keeps ([`CubeDem::source_axes`]):
+/// sample `(c, r)` lies at longitude `lon_first + c lon_step` and latitude
+/// `lat_first + r lat_step` (degrees; rows from south to north).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SourceAxes {
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Longitude of column 0, degrees.
+    pub lon_first: f64,
+    /// Degrees between columns.
+    pub lon_step: f64,
+    /// Latitude of row 0 (the southernmost), degrees.
+    pub lat_first: f64,
+    /// Degrees between rows.
+    pub lat_step: f64,
+    /// Whether the columns go round the whole circle (column `width` is column 0 again).
+    pub wraps: bool,
+}
+
 /// One row of [`CubeDem::storage_table`]: a level of the file or a finer level made by the
 /// detail noise alone (seed 003 Fig. 13).
 #[derive(Clone, Debug, PartialEq)]
@@ -189,6 +210,62 @@ impl CubeDem {
                 ),
             }),
         }
+    }
+
+    /// The axes of the stored source grid (version 2), `None` in a version 1 file.
+    pub fn source_axes(&self) -> Option<SourceAxes> {
+        self.header.source.map(|s| SourceAxes {
+            width: s.width,
+            height: s.height,
+            lon_first: s.lon_first,
+            lon_step: s.lon_step,
+            lat_first: s.lat_first,
+            lat_step: s.lat_step,
+            wraps: s.wraps,
+        })
+    }
+
+    /// Every `stride`-th sample of the stored source grid in both directions: samples
+    /// `(c * stride, r * stride)` for `c < ceil(width / stride)`, `r < ceil(height / stride)`,
+    /// row by row from the south, as `(columns, rows, values)`. Read tile by tile (each tile
+    /// holding a wanted sample once). Errors: a version 1 file, a stride of 0, or a tile that
+    /// cannot be read.
+    pub fn source_decimated(&self, stride: u32) -> Result<(u32, u32, Vec<f32>), DemError> {
+        let Some(src) = self.header.source else {
+            return Err(DemError::OutOfGrid {
+                file: self.path.clone(),
+                detail: "the source grid asked for; the file keeps none (version 1)".into(),
+            });
+        };
+        if stride == 0 {
+            return Err(DemError::OutOfGrid {
+                file: self.path.clone(),
+                detail: "a stride of 0 through the source grid".into(),
+            });
+        }
+        let (w, h) = (src.width.div_ceil(stride), src.height.div_ceil(stride));
+        let mut out = vec![0f32; w as usize * h as usize];
+        // the first multiple of `stride` at or after `a`
+        let first = |a: u32| a.div_ceil(stride) * stride;
+        for k in 0..src.total() {
+            let t = src.tile_ref(k);
+            let (c_first, r_first) = (first(t.c0), first(t.r0));
+            if c_first >= t.c0 + t.w || r_first >= t.r0 + t.h {
+                continue;
+            }
+            let tile = self.tile(self.grid.total + k)?;
+            for r in (r_first..t.r0 + t.h).step_by(stride as usize) {
+                for c in (c_first..t.c0 + t.w).step_by(stride as usize) {
+                    let v = if tile.len() == 1 {
+                        tile[0]
+                    } else {
+                        tile[((r - t.r0) * t.w + (c - t.c0)) as usize]
+                    };
+                    out[(r / stride) as usize * w as usize + (c / stride) as usize] = v;
+                }
+            }
+        }
+        Ok((w, h, out))
     }
 
     /// The value of an in-range source sample of a version 2 file.

@@ -1,0 +1,141 @@
+//! The relief of an elevation-model planet: the `relief` field of `/api/v1/planet` and the grid at
+//! `/api/v1/relief` (docs/specs/http-api-v1.md), from which the viewer takes the materials' heights
+//! the same at every level of detail.
+
+mod common;
+
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use common::{app, get, send, small_config};
+use pmc_dem::{import_cube, CubeDem, EquirectDem, ImportOptions};
+use pmc_planet::{DemSpec, Interpolation, TerrainSpec};
+use pmc_server::ServerConfig;
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../pmc-dem/tests/fixtures")
+        .join(name)
+}
+
+/// ETOPO60 (360 x 180, one degree) imported into a fresh directory, as a terrain.
+fn etopo60(test: &str) -> (TerrainSpec, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("pmc-server-relief-{}-{test}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dem = EquirectDem::read_netcdf(fixture("etopo60.cdf"), None).unwrap();
+    let out = dir.join("earth.pmcdem");
+    let options = ImportOptions {
+        level: Some(5),
+        ..ImportOptions::default()
+    };
+    let report = import_cube(&dem, &out, &options, &|_, _| {}).unwrap();
+    (terrain(&out, report.digest), out)
+}
+
+fn terrain(path: &Path, digest: String) -> TerrainSpec {
+    TerrainSpec::Dem(DemSpec {
+        path: path.to_str().unwrap().into(),
+        digest,
+        interpolation: Interpolation::Bilinear,
+        seed: 7,
+    })
+}
+
+/// A server of `terrain` on the layout made for its body (`pmc serve --dem`).
+fn config(terrain: TerrainSpec) -> ServerConfig {
+    let TerrainSpec::Dem(spec) = &terrain else {
+        unreachable!()
+    };
+    ServerConfig {
+        layout: pmc_dem::dem_layout(spec).unwrap(),
+        terrain,
+        ..small_config()
+    }
+}
+
+fn floats(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+#[tokio::test]
+async fn the_relief_is_the_elevation_models_source_grid() {
+    let (terrain, path) = etopo60("grid");
+    let cube = CubeDem::open(&path).unwrap();
+    let a = app(config(terrain));
+    let p = get(&a, "/api/v1/planet").await.json();
+    let sea = p["sea_radius"].as_f64().unwrap();
+    let r = &p["relief"];
+    assert_eq!(r["url"], "/api/v1/relief", "{r}");
+    assert_eq!((r["width"].as_u64(), r["height"].as_u64()), (Some(360), Some(180)));
+    assert_eq!(r["wraps"], true);
+    assert_eq!(r["encoding"], "f32le");
+    assert_eq!(r["digest"], cube.digest());
+    let axes = cube.source_axes().unwrap();
+    assert_eq!(r["lon_first"].as_f64(), Some(axes.lon_first));
+    assert_eq!(r["lat_step"].as_f64(), Some(axes.lat_step));
+    assert_eq!(r["scale"].as_f64(), Some(sea / cube.radius()));
+
+    // the whole grid: every sample as stored
+    let whole = get(&a, "/api/v1/relief").await;
+    assert_eq!(whole.status, StatusCode::OK);
+    assert_eq!(whole.header("content-type"), Some("application/octet-stream"));
+    assert_eq!(whole.header("x-pmc-grid-size"), Some("360x180"));
+    let values = floats(&whole.body);
+    assert_eq!(values.len(), 360 * 180);
+    for (k, v) in values.iter().enumerate() {
+        let want = cube.source_sample((k % 360) as u32, (k / 360) as u32).unwrap();
+        assert_eq!(v.to_bits(), want.to_bits(), "sample {k}");
+    }
+    // every 4th sample for at most 100 a side
+    let fourth = get(&a, "/api/v1/relief?max=100").await;
+    assert_eq!(fourth.header("x-pmc-grid-size"), Some("90x45"));
+    assert_eq!(fourth.header("x-pmc-grid-stride"), Some("4"));
+    let v4 = floats(&fourth.body);
+    assert_eq!(v4.len(), 90 * 45);
+    assert_eq!(v4[90 * 10 + 7].to_bits(), values[360 * 40 + 28].to_bits());
+
+    // the ETag names the digest and the stride: a revalidation is a 304 with no body
+    let etag = whole.header("etag").unwrap().to_owned();
+    assert_eq!(etag, format!("\"{}-s1\"", cube.digest()));
+    assert_ne!(fourth.header("etag").unwrap(), etag);
+    let req = Request::get("/api/v1/relief")
+        .header("if-none-match", &etag)
+        .body(Body::empty())
+        .unwrap();
+    let again = send(&a, req).await;
+    assert_eq!(again.status, StatusCode::NOT_MODIFIED);
+    assert!(again.body.is_empty());
+
+    // a bad max is refused, saying what it must be
+    for bad in ["0", "-3", "lots", "1.5"] {
+        let r = get(&a, &format!("/api/v1/relief?max={bad}")).await;
+        assert_eq!(r.status, StatusCode::BAD_REQUEST, "max={bad}");
+        assert!(r.json()["error"].as_str().unwrap().contains("max must be"), "max={bad}");
+    }
+    // another planet asked for by name has none
+    let mars = get(&a, "/api/v1/planet?preset=mars").await.json();
+    assert!(mars["relief"].is_null(), "{}", mars["relief"]);
+}
+
+#[tokio::test]
+async fn a_preset_or_a_version_1_file_has_no_relief() {
+    let a = app(small_config());
+    let p = get(&a, "/api/v1/planet").await.json();
+    assert!(p["relief"].is_null(), "{}", p["relief"]);
+    let r = get(&a, "/api/v1/relief").await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    assert!(r.json()["error"].as_str().unwrap().contains("--dem"));
+
+    let v1 = fixture("etopo60_l6_v1.pmcdem");
+    let digest = CubeDem::open(&v1).unwrap().digest().to_owned();
+    let a = app(config(terrain(&v1, digest)));
+    let p = get(&a, "/api/v1/planet").await.json();
+    assert_eq!(p["terrain"]["kind"], "dem");
+    assert!(p["relief"].is_null(), "{}", p["relief"]);
+    let r = get(&a, "/api/v1/relief").await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    assert!(r.json()["error"].as_str().unwrap().contains("version 2"));
+}
