@@ -16,6 +16,7 @@ import {
   SPACE,
   SUN_DISC,
   SUN_RADIUS,
+  SURFACE_SCATTER,
   sunDirection,
   type AtmosphereParams,
 } from './atmosphereModel';
@@ -158,7 +159,8 @@ vec3 pmcAerialPerspective(vec3 colour, vec3 rel) {
   // a step per half scale height, at most AERIAL_SAMPLES: near terrain costs one or two
   int n = int(clamp(ceil(2.0 * (t1 - span.x) / uAtmoRayleighH), 1.0, ${f(AERIAL_SAMPLES)}));
   pmcScatter(dir, span.x, t1, n, light, trans);
-  return colour * trans + pmcExposure(light);
+  // through SURFACE_SCATTER of the air (atmosphereModel.ts)
+  return colour * pow(trans, vec3(${f(SURFACE_SCATTER)})) + pmcExposure(${f(SURFACE_SCATTER)} * light);
 }
 `;
 

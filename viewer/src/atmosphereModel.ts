@@ -212,6 +212,20 @@ export function sunDirection(enu: Enu, azimuth: number, elevation: number): V3 {
 export const SKY_SAMPLES = 12;
 export const AERIAL_SAMPLES = 6;
 
+/**
+ * How thick the air between the eye and a surface counts, of the sky's: a surface's aerial
+ * perspective takes this share of the path's optical depth (transmittance `T^k`) and of its
+ * scattered light (`1 - exp(-k L)`). The ground is lit on the scale of its albedo (a white surface
+ * facing the sun shows about white), while the sky is exposed for a sun of `sun` irradiance: a
+ * sunlit field of albedo 0.1 then shows 0.1 against a horizon sky near 0.8, eight times darker,
+ * where a camera sees the horizon sky two or three times as bright as the field. Through the
+ * whole air that field drowned: the real Earth from 10 km a blue-grey veil with no land in it,
+ * the earth preset's continent pale blue from orbit. A third of it keeps the air's colour, its
+ * growth with distance and the blue it gives the ground seen from orbit, and leaves the ground
+ * readable to the horizon.
+ */
+export const SURFACE_SCATTER = 0.35;
+
 /** Rayleigh phase function (per steradian) at the cosine `nu` of the scattering angle. */
 export function rayleighPhase(nu: number): number {
   return (3 / (16 * Math.PI)) * (1 + nu * nu);
@@ -411,8 +425,9 @@ export function sunDisc(nu: number): number {
 
 /**
  * Aerial perspective: `colour` (linear RGB) of a surface at `rel` (planet frame, from the
- * camera at `camera`) seen through the air between: attenuated by the transmittance, plus the
- * light scattered on the way (exposed as the sky is). Unchanged without an atmosphere.
+ * camera at `camera`) seen through the air between: attenuated by the transmittance, plus
+ * the light scattered on the way (exposed as the sky is), through `SURFACE_SCATTER` of the air. Unchanged without
+ * an atmosphere.
  */
 export function aerialPerspective(a: AtmosphereParams | null, colour: V3, camera: V3, rel: V3, sun: V3): V3 {
   if (!a) return colour;
@@ -429,6 +444,8 @@ export function aerialPerspective(a: AtmosphereParams | null, colour: V3, camera
   // a step per half scale height, at most AERIAL_SAMPLES: near terrain costs one or two
   const n = Math.min(AERIAL_SAMPLES, Math.max(1, Math.ceil((2 * (t1 - span.enter)) / a.rayleighHeight)));
   const s = scatter(a, camera, dir, sun, span.enter, t1, n);
-  const e = exposure(s.light);
-  return [colour[0] * s.transmittance[0] + e[0], colour[1] * s.transmittance[1] + e[1], colour[2] * s.transmittance[2] + e[2]];
+  const k = SURFACE_SCATTER;
+  const e = exposure([k * s.light[0], k * s.light[1], k * s.light[2]]);
+  const tr = s.transmittance.map((x) => Math.pow(x, k));
+  return [colour[0] * tr[0]! + e[0], colour[1] * tr[1]! + e[1], colour[2] * tr[2]! + e[2]];
 }

@@ -198,6 +198,23 @@ float pmcFiltered(vec3 q, int octaves, float fw) {
   }
   return 0.5 + sum;
 }
+// Variation at every scale between kilometres and metres: octaves of value noise of the unit
+// direction from cells of firstCell metres down to 6 m, each faded out below the pixel (mpp
+// metres per pixel) and the coarsest first, so a view costs only the octaves it resolves. Around
+// 0.5. (Finer than 6 m the f32 direction would jitter the lattice; the detail noise takes over.)
+float pmcAllScales(vec3 up, float firstCell, float mpp) {
+  float sum = 0.0;
+  float amp = 0.5;
+  float cell = firstCell;
+  for (int i = 0; i < 14; i++) {
+    if (cell < 6.0) break;
+    float fw = mpp / cell;
+    if (fw < 0.45) sum += amp * pmcResolved(fw) * (pmcValueNoise(up * (uDatum / cell) + float(i) * 13.7) - 0.5);
+    amp *= 0.85;
+    cell *= 0.5;
+  }
+  return 0.5 + sum;
+}
 vec3 pmcMat(int i, float t) { return mix(uMatA[i], uMatB[i], t); }
 // 0 below the line, 1 above it, a smooth step of half-width w; lines at +-1e30 are absent.
 float pmcAbove(float x, float line, float w) {
@@ -353,7 +370,11 @@ void main() {
   float m1 = pmcFiltered(up * uMacroFreq, 4, metresPerPixel * uMacroFreq / max(uDatum, 1.0));
   float m2 = pmcFiltered(up * (0.31 * uMacroFreq) + 53.0, 4, 0.31 * metresPerPixel * uMacroFreq / max(uDatum, 1.0));
   float detail = pmcFiltered(vDetailPos, 4, metresPerPixel * uDetailFreq);
-  float t = clamp(0.5 + 2.5 * (meso - 0.5), 0.0, 1.0);
+  // variation from the picture's cells (or 0.3 % of the radius: 19 km on the Earth) down to 6 m,
+  // where the tile-sized noise above is too fine to see and the picture too coarse
+  float firstCell = uHasImagery > 0.5 ? uImageryCell : 0.003 * uDatum;
+  float scales = pmcAllScales(up, firstCell, metresPerPixel);
+  float t = clamp(0.5 + 2.5 * (meso - 0.5) + 2.5 * (scales - 0.5), 0.0, 1.0);
   vec3 base = pmcGround(h, up, slope, t, clamp(jit, -1.0, 1.0), m1, m2, metresPerPixel);
   bool underwater = uHasSea > 0.5 && h < 0.0;
   // (sampled outside the branch: texture gradients need the whole pixel quad)
@@ -361,7 +382,10 @@ void main() {
   if (uHasImagery > 0.5 && !underwater) {
     // metres per pixel against the picture's cell: below its resolution, the procedural detail
     float below = 1.0 - smoothstep(0.05, 0.5, metresPerPixel / max(uImageryCell, 1e-3));
-    vec3 draped = img.rgb * (1.0 + 0.6 * (t - 0.5) * below);
+    // below the picture's cells: lighter and drier or darker and greener patches at every scale
+    float s = clamp(3.0 * (scales - 0.5), -1.0, 1.0);
+    vec3 tint = s < 0.0 ? mix(vec3(1.0), vec3(0.78, 0.92, 0.74), -s) : mix(vec3(1.0), vec3(1.2, 1.12, 0.94), s);
+    vec3 draped = img.rgb * mix(vec3(1.0), tint * (1.0 + 0.4 * (t - 0.5)), below);
     float steep = 1.0 - smoothstep(uMatSlopes.x - 0.06, uMatSlopes.x + 0.06, slope);
     draped = mix(draped, pmcMat(6, t), 0.6 * steep * below);
     base = mix(base, draped, img.a);

@@ -44,18 +44,26 @@ export async function scenario(t) {
     ...heights.slice(1).map((h) => ({ name: `${h}m`, height: h, pitch: pitches[h] ?? -15 })),
   ];
 
+  // PMC_E2E_GALLERY_ONLY=earthlike,earth,dem: some of the planets (while working on a look)
+  const only = (what) => !process.env.PMC_E2E_GALLERY_ONLY || process.env.PMC_E2E_GALLERY_ONLY.split(',').includes(what);
+
   // the default planet (earthlike, seed 7: 1.9 km to the sea)
-  await page.goto(`${t.shared.pageBase}#preset=earthlike&seed=7&mode=orbit&lat=-10&lon=8`, { waitUntil: 'load', timeout: 60_000 });
-  await page.waitForFunction(() => window.__pmc !== undefined && window.__pmc.stats().preset === 'earthlike', null, { timeout: 60_000 });
-  await descent(t, 'gallery-earthlike', -10, 8, stops([6000, 1000, 100, 10, 2], { 1000: -60 }));
+  if (only('earthlike')) {
+    await page.goto(`${t.shared.pageBase}#preset=earthlike&seed=7&mode=orbit&lat=-10&lon=8`, { waitUntil: 'load', timeout: 60_000 });
+    await page.waitForFunction(() => window.__pmc !== undefined && window.__pmc.stats().preset === 'earthlike', null, { timeout: 60_000 });
+    await descent(t, 'gallery-earthlike', -10, 8, stops([6000, 1000, 100, 10, 2], { 1000: -60 }));
+  }
 
   // the earth preset at true scale: low land near the equator, 140 m above the sea
-  const earth = await startBackend(null, { extra: ['--preset', 'earth'] });
-  await page.goto(`${earth.url}#preset=earth&seed=7&mode=orbit&lat=5&lon=100`, { waitUntil: 'load', timeout: 60_000 });
-  await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
-  await descent(t, 'gallery-earth', 5, 100, stops([12_000_000, 100_000, 10_000, 100, 2]));
-  await page.goto('about:blank');
-  await earth.stop();
+  if (only('earth')) {
+    const earth = await startBackend(null, { extra: ['--preset', 'earth'] });
+    await page.goto(`${earth.url}#preset=earth&seed=7&mode=orbit&lat=5&lon=100`, { waitUntil: 'load', timeout: 60_000 });
+    await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+    await descent(t, 'gallery-earth', 5, 100, stops([12_000_000, 100_000, 10_000, 100, 2]));
+    await page.goto('about:blank');
+    await earth.stop();
+  }
+  if (!only('dem')) return;
 
   // the real Earth: ETOPO5 (where installed) with NASA's picture draped over it, the Bay of
   // Naples
