@@ -199,9 +199,10 @@ float pmcFiltered(vec3 q, int octaves, float fw) {
   return 0.5 + sum;
 }
 // Variation at every scale between kilometres and metres: octaves of value noise of the unit
-// direction from cells of firstCell metres down to 6 m, each faded out below the pixel (mpp
-// metres per pixel) and the coarsest first, so a view costs only the octaves it resolves. Around
-// 0.5. (Finer than 6 m the f32 direction would jitter the lattice; the detail noise takes over.)
+// direction from cells of firstCell metres down to 6 m, each faded out as its cells shrink from
+// 32 to 8 pixels (mpp metres per pixel: patches, never grain) and the coarsest first, so a view
+// costs only the octaves it shows. Around 0.5. (Finer than 6 m the f32 direction would jitter the
+// lattice; the detail noise takes over.)
 float pmcAllScales(vec3 up, float firstCell, float mpp) {
   float sum = 0.0;
   float amp = 0.5;
@@ -209,7 +210,7 @@ float pmcAllScales(vec3 up, float firstCell, float mpp) {
   for (int i = 0; i < 14; i++) {
     if (cell < 6.0) break;
     float fw = mpp / cell;
-    if (fw < 0.45) sum += amp * pmcResolved(fw) * (pmcValueNoise(up * (uDatum / cell) + float(i) * 13.7) - 0.5);
+    if (fw < 0.125) sum += amp * (1.0 - smoothstep(0.03125, 0.125, fw)) * (pmcValueNoise(up * (uDatum / cell) + float(i) * 13.7) - 0.5);
     amp *= 0.85;
     cell *= 0.5;
   }

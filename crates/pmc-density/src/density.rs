@@ -59,6 +59,16 @@ pub trait Density: Send + Sync {
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         None
     }
+
+    /// The radius of the ground along each unit direction of `dirs`, into `out` (as long as
+    /// `dirs`), as the terrain's height model gives it before its 3D features (overhangs, caves,
+    /// rocks) move the surface, band-limited to features of about `detail` metres: the height a
+    /// viewer colours the ground by from afar, the same whatever level of detail is drawn.
+    /// Returns `false`, leaving `out` as it is, when the density has no height model.
+    fn ground_radii(&self, dirs: &[DVec3], detail: f64, out: &mut [f64]) -> bool {
+        let _ = (dirs, detail, out);
+        false
+    }
 }
 
 /// What a density batch computed once per direction (a column model's columns), kept with the
@@ -141,6 +151,9 @@ impl<T: Density + ?Sized> Density for Box<T> {
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         (**self).radial_bounds()
     }
+    fn ground_radii(&self, dirs: &[DVec3], detail: f64, out: &mut [f64]) -> bool {
+        (**self).ground_radii(dirs, detail, out)
+    }
 }
 
 impl<T: Density + ?Sized> Density for std::sync::Arc<T> {
@@ -155,6 +168,9 @@ impl<T: Density + ?Sized> Density for std::sync::Arc<T> {
     }
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         (**self).radial_bounds()
+    }
+    fn ground_radii(&self, dirs: &[DVec3], detail: f64, out: &mut [f64]) -> bool {
+        (**self).ground_radii(dirs, detail, out)
     }
 }
 

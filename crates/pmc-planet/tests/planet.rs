@@ -196,3 +196,89 @@ fn a_scratch_shared_by_planets_of_two_layouts_kept_the_other_layouts_grid() {
     }
     assert!(surfaces > 10, "{surfaces} chunks with a surface");
 }
+
+/// The ground of every preset's height model (`Density::ground_radii`, the materials' height the
+/// viewer takes from afar): inside the density's radial bounds, and where no overhang or cave
+/// moves the surface, the first surface met going down the column, within a quarter voxel for
+/// most columns; the same values one direction at a time and in a batch. The sphere has no
+/// height model.
+#[test]
+fn the_ground_of_each_presets_height_model_is_its_surface() {
+    use pmc_density::Density;
+    let layout = Layout::new(4, 16, 1744.0, 4.0, 64).unwrap();
+    let dirs: Vec<DVec3> = (0..400)
+        .map(|k| {
+            // a Fibonacci spiral of directions
+            let y = 1.0 - 2.0 * (k as f64 + 0.5) / 400.0;
+            let phi = k as f64 * 2.399_963_229_728_653;
+            let s = (1.0 - y * y).sqrt();
+            DVec3::new(s * phi.cos(), y, s * phi.sin())
+        })
+        .collect();
+    for preset in [PresetKind::Earthlike, PresetKind::Moon, PresetKind::Mars] {
+        let planet = Planet::new(preset, 7, layout);
+        let density = &planet.terrain().density;
+        let mut ground = vec![0.0; dirs.len()];
+        assert!(density.ground_radii(&dirs, 10.0, &mut ground), "{preset:?}");
+        let (lo, hi) = density.radial_bounds().unwrap();
+        let mut off = Vec::new();
+        for (k, (d, g)) in dirs.iter().zip(&ground).enumerate() {
+            assert!(*g >= lo && *g <= hi, "{preset:?}: ground {g} outside {lo}..{hi}");
+            let mut one = [0.0];
+            assert!(density.ground_radii(&[*d], 10.0, &mut one));
+            assert_eq!(
+                one[0].to_bits(),
+                g.to_bits(),
+                "{preset:?} direction {k}: batch and single differ"
+            );
+            off.push((planet.surface_radius(*d) - g).abs());
+        }
+        off.sort_by(f64::total_cmp);
+        let median = off[off.len() / 2];
+        assert!(
+            median <= 0.25 * layout.l_d(),
+            "{preset:?}: median {median} m off the surface"
+        );
+    }
+    let sphere = Planet::new(PresetKind::Sphere, 7, layout);
+    let mut out = [7.0];
+    assert!(!sphere.terrain().density.ground_radii(&dirs[..1], 10.0, &mut out));
+    assert_eq!(out, [7.0]);
+}
+
+/// The earth preset's ground at true scale: inside its radial bounds, refined to the detail asked
+/// for (at 40 km within 200 m of the ground at 100 m), the same one at a time and in a batch.
+#[test]
+fn the_earth_presets_ground_is_refined_to_the_detail_asked_for() {
+    use pmc_density::Density;
+    let layout = PresetKind::Earth.default_layout(None).unwrap();
+    let planet = Planet::new(PresetKind::Earth, 7, layout);
+    let density = &planet.terrain().density;
+    let dirs: Vec<DVec3> = (0..64)
+        .map(|k| {
+            DVec3::new(
+                (k as f64 * 0.37).sin(),
+                (k as f64 * 0.11).cos(),
+                (k as f64 * 0.73).sin() + 0.2,
+            )
+            .normalize()
+        })
+        .collect();
+    let (lo, hi) = density.radial_bounds().unwrap();
+    let (mut coarse, mut fine) = (vec![0.0; dirs.len()], vec![0.0; dirs.len()]);
+    assert!(density.ground_radii(&dirs, 40_000.0, &mut coarse));
+    assert!(density.ground_radii(&dirs, 100.0, &mut fine));
+    for (k, (c, f)) in coarse.iter().zip(&fine).enumerate() {
+        assert!(
+            *c >= lo && *c <= hi && *f >= lo && *f <= hi,
+            "direction {k}: {c} {f} outside {lo}..{hi}"
+        );
+        assert!(
+            (c - f).abs() <= 200.0 + 0.5,
+            "direction {k}: {c} at 40 km, {f} at 100 m"
+        );
+        let mut one = [0.0];
+        assert!(density.ground_radii(&dirs[k..=k], 100.0, &mut one));
+        assert_eq!(one[0].to_bits(), f.to_bits());
+    }
+}

@@ -92,7 +92,7 @@ pub async fn planet(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
         "materials": t.materials,
         "palette": { "a": t.blend_colors[0], "b": t.blend_colors[1] },
         "imagery": crate::imagery_api::planet_field(&state, *id == state.config().terrain),
-        "relief": crate::relief_api::planet_field(&state, &t.spec, t.sea_radius),
+        "relief": crate::relief_api::planet_field(&state, &t.spec, &planet, *id == state.config().terrain),
         "edit": crate::edit_api::edit_info(&state, id),
     });
     Ok(json_response(v, "no-cache"))

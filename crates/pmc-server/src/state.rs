@@ -162,7 +162,7 @@ impl AppState {
                 Some(Arc::new(editing))
             }
         };
-        let relief = crate::relief_api::ServedRelief::of(&config.terrain)?.map(Arc::new);
+        let relief = crate::relief_api::ServedRelief::of(&config.terrain, &config.layout)?.map(Arc::new);
         // A height-field planet brings its own (patch) layout: built now, kept as the server's.
         let heightfield = match config.mesher {
             crate::config::Mesher::Heightfield => {

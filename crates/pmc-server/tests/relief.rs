@@ -8,6 +8,7 @@ use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use common::{app, get, send, small_config};
 use pmc_dem::{import_cube, CubeDem, EquirectDem, ImportOptions};
+use pmc_density::Density;
 use pmc_planet::{DemSpec, Interpolation, TerrainSpec};
 use pmc_server::ServerConfig;
 use std::path::{Path, PathBuf};
@@ -121,14 +122,68 @@ async fn the_relief_is_the_elevation_models_source_grid() {
 }
 
 #[tokio::test]
-async fn a_preset_or_a_version_1_file_has_no_relief() {
+async fn a_presets_relief_is_its_ground_on_a_grid_of_cell_centres() {
     let a = app(small_config());
     let p = get(&a, "/api/v1/planet").await.json();
-    assert!(p["relief"].is_null(), "{}", p["relief"]);
-    let r = get(&a, "/api/v1/relief").await;
-    assert_eq!(r.status, StatusCode::NOT_FOUND);
-    assert!(r.json()["error"].as_str().unwrap().contains("--dem"));
+    let r = &p["relief"];
+    assert_eq!(
+        (r["width"].as_u64(), r["height"].as_u64()),
+        (Some(1024), Some(512)),
+        "{r}"
+    );
+    assert_eq!(
+        (r["lon_first"].as_f64(), r["lon_step"].as_f64()),
+        (Some(-180.0 + 180.0 / 1024.0), Some(360.0 / 1024.0))
+    );
+    assert_eq!(
+        (r["lat_first"].as_f64(), r["lat_step"].as_f64()),
+        (Some(-90.0 + 90.0 / 512.0), Some(180.0 / 512.0))
+    );
+    assert_eq!((r["wraps"].as_bool(), r["scale"].as_f64()), (Some(true), Some(1.0)));
+    let whole = get(&a, "/api/v1/relief").await;
+    assert_eq!(whole.status, StatusCode::OK);
+    let values = floats(&whole.body);
+    assert_eq!(values.len(), 1024 * 512);
+    // the ground of the planet itself: where no overhang or cave moves it, the first surface met
+    // going down the column lies within a voxel of it
+    let planet = pmc_planet::Planet::new(pmc_planet::PresetKind::Earthlike, 3, common::small_layout());
+    let datum = planet.datum_radius();
+    let (lo, hi) = planet.terrain().density.radial_bounds().unwrap();
+    let mut off = Vec::new();
+    for k in (0..values.len()).step_by(997) {
+        let (c, row) = (k % 1024, k / 1024);
+        let lat = -90.0 + (row as f64 + 0.5) * 180.0 / 512.0;
+        let lon = -180.0 + (c as f64 + 0.5) * 360.0 / 1024.0;
+        let g = datum + f64::from(values[k]);
+        assert!(
+            g >= lo - 1e-6 && g <= hi + 1e-6,
+            "ground {g} outside the density's bounds {lo}..{hi}"
+        );
+        let dir = pmc_geometry::LatLon::new(lat, lon).unwrap().to_unit();
+        off.push((planet.surface_radius(dir) - g).abs());
+    }
+    off.sort_by(f64::total_cmp);
+    let l_d = common::small_layout().l_d();
+    assert!(
+        off[off.len() / 2] <= 0.25 * l_d,
+        "median {} of {} columns",
+        off[off.len() / 2],
+        off.len()
+    );
+    // the same grid again, and a digest that names it
+    let again = get(&a, "/api/v1/relief").await;
+    assert_eq!(again.body, whole.body);
+    assert_eq!(
+        whole.header("etag").map(str::to_owned),
+        Some(format!("\"{}-s1\"", r["digest"].as_str().unwrap()))
+    );
+    // another planet asked for by name has none
+    let mars = get(&a, "/api/v1/planet?preset=mars").await.json();
+    assert!(mars["relief"].is_null(), "{}", mars["relief"]);
+}
 
+#[tokio::test]
+async fn a_version_1_file_has_no_relief() {
     let v1 = fixture("etopo60_l6_v1.pmcdem");
     let digest = CubeDem::open(&v1).unwrap().digest().to_owned();
     let a = app(config(terrain(&v1, digest)));

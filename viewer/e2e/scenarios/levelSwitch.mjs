@@ -24,11 +24,13 @@ export const MAX_DELTA_E = 3;
 /**
  * The share of places on the default planet allowed over MAX_DELTA_E: on a planet this small the
  * lines between materials lie a metre or two apart in height (the shore's sand band is 3 m
- * high), while the flat triangles of the coarse level sag 0.6 m below the surface between their
- * vertices and a pixel beside the place sampled spans 9 m of ground, so a place on a line gets
- * another share of the two materials. Measured: 8 % (levels 1-2) and 13 % (levels 2-3), median 0.
+ * high), and the pixel a place falls in is up to 0.7 pixels (7 m of ground) off it, where the
+ * coarse level's flat triangles lie up to 0.6 m lower and meet the ray at another place, on
+ * another side of a line. The materials' height comes from the planet's ground grid here (the
+ * relief, 11.7 m cells), not from the meshes: measured 1 % (levels 1-2) and 6 % (levels 2-3),
+ * median 0 (8 % and 13 % with the meshes' heights).
  */
-export const SHARE_OVER = 0.15;
+export const SHARE_OVER = 0.08;
 
 /** Metres between two planet-frame points along the ground: the part of `q - p` across `p`'s vertical. */
 function acrossGround(p, q) {

@@ -555,7 +555,6 @@ impl EarthModel {
     }
 
     /// Refines `col` until its height is known within `tol` metres (or the ladder ends).
-    #[cfg(test)]
     pub(crate) fn refine_to(&self, col: &mut EarthColumn, dir: DVec3, tol: f64) {
         while col.done < self.entries.len() && col.rem[col.done] > tol {
             self.advance(col, dir);
@@ -697,6 +696,20 @@ fn ladder(seed: u64, ratio: f64, tile: f64) -> Vec<Entry> {
 pub(crate) struct EarthDensity(pub Arc<EarthModel>);
 
 impl Density for EarthDensity {
+    /// The columns' heights refined until the octaves left amount to at most half a percent of
+    /// `detail` (at least a metre): a height for features of about `detail` metres.
+    fn ground_radii(&self, dirs: &[DVec3], detail: f64, out: &mut [f64]) -> bool {
+        assert_eq!(out.len(), dirs.len(), "output buffer has the wrong size");
+        let m = &*self.0;
+        let tol = (0.005 * detail).max(1.0);
+        for (o, dir) in out.iter_mut().zip(dirs) {
+            let mut col = m.column(*dir);
+            m.refine_to(&mut col, *dir, tol);
+            *o = col.height();
+        }
+        true
+    }
+
     fn density(&self, p: DVec3) -> f64 {
         let m = &*self.0;
         let (r, dir) = radial(p);

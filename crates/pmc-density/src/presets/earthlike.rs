@@ -314,6 +314,10 @@ impl ColumnModel for EarthModel {
         );
     }
 
+    fn ground_radius(&self, col: &EarthColumn) -> f64 {
+        col.h
+    }
+
     fn bounds(&self) -> (f64, f64) {
         self.bounds
     }

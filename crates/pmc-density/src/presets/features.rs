@@ -103,6 +103,9 @@ pub(crate) trait ColumnModel: Send + Sync + 'static {
     }
     /// Sound radial bounds (see [`Density::radial_bounds`]).
     fn bounds(&self) -> (f64, f64);
+    /// The radius of the column's ground before the 3D features move it (see
+    /// [`Density::ground_radii`]).
+    fn ground_radius(&self, col: &Self::Column) -> f64;
 }
 
 /// The key of a model shared by a terrain's density and shader, for [`ShellColumns`]: its
@@ -144,6 +147,18 @@ impl<M: ColumnModel> Density for ColumnDensity<M> {
 
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         Some(self.0.bounds())
+    }
+
+    /// The columns' heights (their fractal sums run to the model's finest octave whatever
+    /// `detail` asks: a column is one batch of them).
+    fn ground_radii(&self, dirs: &[DVec3], _detail: f64, out: &mut [f64]) -> bool {
+        assert_eq!(out.len(), dirs.len(), "output buffer has the wrong size");
+        let mut cols = Vec::with_capacity(dirs.len());
+        self.0.columns(dirs, &mut cols);
+        for (o, c) in out.iter_mut().zip(&cols) {
+            *o = self.0.ground_radius(c);
+        }
+        true
     }
 }
 

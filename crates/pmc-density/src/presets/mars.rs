@@ -258,6 +258,10 @@ impl ColumnModel for MarsModel {
         );
     }
 
+    fn ground_radius(&self, col: &MarsColumn) -> f64 {
+        col.h
+    }
+
     fn bounds(&self) -> (f64, f64) {
         self.bounds
     }

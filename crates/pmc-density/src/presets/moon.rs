@@ -159,6 +159,10 @@ impl ColumnModel for MoonModel {
         carved_voxels(None, &self.tubes, cols, |c| (c.h, 0.0, c.band), dirs, radii, out);
     }
 
+    fn ground_radius(&self, col: &MoonColumn) -> f64 {
+        col.h
+    }
+
     fn bounds(&self) -> (f64, f64) {
         self.bounds
     }

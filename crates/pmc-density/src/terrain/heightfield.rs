@@ -225,6 +225,10 @@ impl ColumnModel for Model {
         d
     }
 
+    fn ground_radius(&self, col: &Column) -> f64 {
+        col.h
+    }
+
     fn bounds(&self) -> (f64, f64) {
         self.bounds
     }
