@@ -357,12 +357,13 @@ void main() {
   vec3 ray = normalize(vRel);
   float metresPerPixel = length(vRel) * max(length(dFdx(ray)), length(dFdy(ray)));
   // The height the materials and the sea go by: the mesh's, or, where a pixel spans more than a
-  // few hundredths of a data cell, the elevation model's relief at the place (the same at every
-  // level, where a coarse chunk's triangles pass hundreds of metres under a finer one's peaks)
+  // few hundredths of a relief cell, the relief at the place (the same at every level, where a
+  // coarse chunk's triangles pass hundreds of metres under a finer one's peaks, and draw the
+  // material lines as polygons dozens of pixels wide)
   float h = vHeight;
   if (uHasRelief > 0.5) {
     vec2 relief = pmcRelief(up);
-    float far = smoothstep(0.03, 0.25, metresPerPixel / max(uReliefScale.y, 1e-3));
+    float far = smoothstep(0.02, 0.08, metresPerPixel / max(uReliefScale.y, 1e-3));
     h = mix(h, relief.x, far * relief.y);
   }
   // the place's noises: fixed frequencies of the planet, filtered by the pixel's footprint

@@ -124,9 +124,11 @@ export async function scenario(t) {
   const before = await look('dem-cave-before', 46.4997, 8, south.height + 25, -35);
   const centre = spot.point;
   const r = Math.hypot(...centre);
-  const inward = centre.map((v) => v * (1 - 6 / r));
+  // a dig 30 m across, its centre 8 m down: a pit wide enough to show at the levels drawn here
+  // (level 3 and coarser, 8 m voxels; a 16 m dig changed a dozen triangles)
+  const inward = centre.map((v) => v * (1 - 8 / r));
   const answer = await hook(
-    ([c]) => fetch('api/v1/edits', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ brush: 'remove', x: c[0], y: c[1], z: c[2], radius: 16 }) }).then(async (x) => ({ status: x.status, body: await x.json() })),
+    ([c]) => fetch('api/v1/edits', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ brush: 'remove', x: c[0], y: c[1], z: c[2], radius: 30 }) }).then(async (x) => ({ status: x.status, body: await x.json() })),
     [inward],
   );
   check(answer.status === 200 && answer.body.chunks.length > 0, `the dig was answered ${JSON.stringify(answer)}`);
