@@ -98,6 +98,21 @@ async fn the_relief_is_the_elevation_models_source_grid() {
     assert_eq!(v4.len(), 90 * 45);
     assert_eq!(v4[90 * 10 + 7].to_bits(), values[360 * 40 + 28].to_bits());
 
+    // compressed once when the client takes gzip
+    let req = Request::get("/api/v1/relief")
+        .header("accept-encoding", "gzip, br")
+        .body(Body::empty())
+        .unwrap();
+    let zipped = send(&a, req).await;
+    assert_eq!(zipped.header("content-encoding"), Some("gzip"));
+    let mut unzipped = Vec::new();
+    std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&zipped.body[..]), &mut unzipped).unwrap();
+    assert_eq!(unzipped, whole.body.to_vec());
+    let req = Request::get("/api/v1/relief")
+        .header("accept-encoding", "gzip;q=0")
+        .body(Body::empty())
+        .unwrap();
+    assert_eq!(send(&a, req).await.header("content-encoding"), None);
     // the ETag names the digest and the stride: a revalidation is a 304 with no body
     let etag = whole.header("etag").unwrap().to_owned();
     assert_eq!(etag, format!("\"{}-s1\"", cube.digest()));
