@@ -230,13 +230,11 @@ float pmcShare(float n, float share) {
   return smoothstep(th - 0.03, th + 0.03, n);
 }
 // The albedo of the ground at height h (m above the datum) along the unit direction up, with
-// cos(slope) slope, palette mix t, line jitter jit (-1..1), large-scale noises m1, m2, seen at
-// mpp metres per pixel. Height lines are smooth steps, and slopes count less as the pixel grows
-// past a tile (a coarse level smooths them): a place's colour hardly changes with the level drawn.
-vec3 pmcGround(float h, vec3 up, float slope, float t, float jit, float m1, float m2, float mpp) {
+// cos(slope) slope counting slopeWeight (0..1), palette mix t, line jitter jit (-1..1),
+// large-scale noises m1, m2. Height lines are smooth steps: a place's colour hardly changes with
+// the level drawn.
+vec3 pmcGround(float h, vec3 up, float slope, float t, float jit, float m1, float m2, float slopeWeight) {
   float w = uMatExtra.y;
-  float tile = 0.5 / max(uNoiseFreq, 1e-9);
-  float slopeWeight = 1.0 - smoothstep(0.1, 1.0, mpp / tile);
   if (uHasSea > 0.5 && h < 0.0) {
     float deep = uMatHeights.x > 1e29 ? 0.0 : smoothstep(0.7 * uMatHeights.x, 1.3 * uMatHeights.x, -h);
     return mix(pmcMat(1, t), pmcMat(0, t), deep);
@@ -295,8 +293,9 @@ vec4 pmcImagery(vec3 up) {
   return vec4(c, inside);
 }
 // The relief's height (metres above the datum) at the unit direction up, bilinear in column and
-// row as relief.ts's reliefHeightAt; .y 1 on the grid, 0 off a regional one.
-vec2 pmcRelief(vec3 up) {
+// row as relief.ts's reliefHeightAt; .y 1 on the grid, 0 off a regional one; .z the cosine of its
+// slope (from the bilinear patch's gradient, metres per metre along the parallel and the meridian).
+vec4 pmcRelief(vec3 up) {
   float lat = asin(clamp(up.y, -1.0, 1.0));
   float lon = atan(up.x, up.z);
   float w = uReliefGrid.x;
@@ -330,7 +329,11 @@ vec2 pmcRelief(vec3 up) {
   float n1 = texelFetch(uRelief, ivec2(int(c1), int(r1)), 0).r;
   float south = mix(s0, s1, fx);
   float north = mix(n0, n1, fx);
-  return vec2(mix(south, north, fy) * uReliefScale.x, inside);
+  float cellX = uReliefAxes.y * uDatum * max(cos(lat), 1e-3);
+  float cellY = uReliefAxes.w * uDatum;
+  float gx = mix(s1 - s0, n1 - n0, fy) * uReliefScale.x / max(cellX, 1e-6);
+  float gy = mix(n0 - s0, n1 - s1, fx) * uReliefScale.x / max(cellY, 1e-6);
+  return vec4(mix(south, north, fy) * uReliefScale.x, inside, inversesqrt(1.0 + gx * gx + gy * gy), 0.0);
 }
 void main() {
   #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
@@ -360,11 +363,16 @@ void main() {
   // few hundredths of a relief cell, the relief at the place (the same at every level, where a
   // coarse chunk's triangles pass hundreds of metres under a finer one's peaks, and draw the
   // material lines as polygons dozens of pixels wide)
+  // and the slope: the mesh's counts less as the pixel grows past a tile (a coarse level smooths
+  // it: its normals change with the level), the relief's as much as the relief resolves it
   float h = vHeight;
+  float slopeWeight = 1.0 - smoothstep(0.1, 1.0, metresPerPixel * 2.0 * uNoiseFreq);
   if (uHasRelief > 0.5) {
-    vec2 relief = pmcRelief(up);
-    float far = smoothstep(0.02, 0.08, metresPerPixel / max(uReliefScale.y, 1e-3));
-    h = mix(h, relief.x, far * relief.y);
+    vec4 relief = pmcRelief(up);
+    float far = smoothstep(0.02, 0.08, metresPerPixel / max(uReliefScale.y, 1e-3)) * relief.y;
+    h = mix(h, relief.x, far);
+    slope = mix(slope, relief.z, far);
+    slopeWeight = mix(slopeWeight, 1.0, far);
   }
   // the place's noises: fixed frequencies of the planet, filtered by the pixel's footprint
   float meso = pmcFiltered(vNoisePos, 6, metresPerPixel * uNoiseFreq);
@@ -377,7 +385,7 @@ void main() {
   float firstCell = uHasImagery > 0.5 ? uImageryCell : 0.003 * uDatum;
   float scales = pmcAllScales(up, firstCell, metresPerPixel);
   float t = clamp(0.5 + 2.5 * (meso - 0.5) + 2.5 * (scales - 0.5), 0.0, 1.0);
-  vec3 base = pmcGround(h, up, slope, t, clamp(jit, -1.0, 1.0), m1, m2, metresPerPixel);
+  vec3 base = pmcGround(h, up, slope, t, clamp(jit, -1.0, 1.0), m1, m2, slopeWeight);
   bool underwater = uHasSea > 0.5 && h < 0.0;
   // (sampled outside the branch: texture gradients need the whole pixel quad)
   vec4 img = uHasImagery > 0.5 ? pmcImagery(up) : vec4(0.0);

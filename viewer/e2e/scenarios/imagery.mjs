@@ -36,8 +36,11 @@ export async function scenario(t) {
     await hook((c) => window.__pmc.setCamera(...c), [lat, lon, height, 0, -90]);
     await ready(label);
     const img = await shot(label);
-    // land vertices: the picture colours land, not the sea
-    const places = await visiblePlaces(hook, 4000, (p) => p.ringMin >= 0.5, { minFacing: 0.5 });
+    // land vertices: the picture colours land, not the sea. From orbit the sea goes by the
+    // planet's relief (its ground on 11.7 m cells, relief.ts), which lies within a voxel of the
+    // mesh: the triangles round a vertex at least 2 m above the datum (0.5 m let in coast
+    // vertices under the relief's sea, 2 of 326 in one run)
+    const places = await visiblePlaces(hook, 4000, (p) => p.ringMin >= 2, { minFacing: 0.5 });
     const errors = [];
     let seam = 0;
     for (const p of places) {
