@@ -92,6 +92,31 @@ pub(crate) fn planet_field(state: &AppState, is_default_planet: bool) -> Value {
     }
 }
 
+/// The `max` parameter of a grid or a picture (`GET /api/v1/imagery`, `/relief`): the most
+/// `units` a side may have, `u32::MAX` when absent; a 400 saying what it must be otherwise.
+pub(crate) fn max_side(params: &Params, units: &str) -> Result<u32, ApiError> {
+    match params.get("max") {
+        None => Ok(u32::MAX),
+        Some(s) => match s.trim().parse::<u32>() {
+            Ok(n) if n >= 1 => Ok(n),
+            _ => Err(ApiError::bad_request(format!(
+                "max must be an integer from 1 to {}, the most {units} a side of the {} may have, got '{s}'",
+                u32::MAX,
+                if units == "pixels" { "image" } else { "grid" }
+            ))),
+        },
+    }
+}
+
+/// A `304 Not Modified` with its `ETag` and `Cache-Control: no-cache`.
+pub(crate) fn not_modified(etag: HeaderValue) -> Response {
+    let mut r = StatusCode::NOT_MODIFIED.into_response();
+    r.headers_mut().insert(header::ETAG, etag);
+    r.headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+    r
+}
+
 /// Whether an `If-None-Match` header value names `etag` (or is `*`).
 pub(crate) fn matches_etag(headers: &HeaderMap, etag: &str) -> bool {
     headers
@@ -118,18 +143,7 @@ pub async fn imagery(
     };
     let params = Params::parse(q);
     let img = served.imagery();
-    let max = match params.get("max") {
-        None => u32::MAX,
-        Some(s) => match s.trim().parse::<u32>() {
-            Ok(n) if n >= 1 => n,
-            _ => {
-                return Err(ApiError::bad_request(format!(
-                    "max must be an integer from 1 to {}, the most pixels a side of the image may have, got '{s}'",
-                    u32::MAX
-                )))
-            }
-        },
-    };
+    let max = max_side(&params, "pixels")?;
     let size = img.level_size(max);
     let etag = if size == (img.width(), img.height()) {
         format!("\"{}\"", img.digest())
@@ -140,10 +154,7 @@ pub async fn imagery(
         HeaderValue::from_str(&etag).map_err(|_| ApiError::internal("the imagery digest is not a valid ETag"))?;
     let cache = HeaderValue::from_static("no-cache");
     if matches_etag(&headers, &etag) {
-        let mut r = StatusCode::NOT_MODIFIED.into_response();
-        r.headers_mut().insert(header::ETAG, etag_value);
-        r.headers_mut().insert(header::CACHE_CONTROL, cache);
-        return Ok(r);
+        return Ok(not_modified(etag_value));
     }
     let png = served.png(size, max).await?;
     let mut r = png.into_response();

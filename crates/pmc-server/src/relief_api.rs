@@ -13,7 +13,7 @@ use crate::request::{ApiError, Params};
 use crate::AppState;
 use axum::body::Bytes;
 use axum::extract::{RawQuery, State};
-use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
+use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use pmc_dem::{CubeDem, DemError};
 use pmc_density::Density;
@@ -322,28 +322,14 @@ pub async fn relief(
         ));
     };
     let params = Params::parse(q);
-    let max = match params.get("max") {
-        None => u32::MAX,
-        Some(s) => match s.trim().parse::<u32>() {
-            Ok(n) if n >= 1 => n,
-            _ => {
-                return Err(ApiError::bad_request(format!(
-                    "max must be an integer from 1 to {}, the most samples a side of the grid may have, got '{s}'",
-                    u32::MAX
-                )))
-            }
-        },
-    };
+    let max = crate::imagery_api::max_side(&params, "samples")?;
     let stride = served.stride_for(max);
     let etag = format!("\"{}-s{stride}\"", served.digest());
     let etag_value =
         HeaderValue::from_str(&etag).map_err(|_| ApiError::internal("the relief digest is not a valid ETag"))?;
     let cache = HeaderValue::from_static("no-cache");
     if crate::imagery_api::matches_etag(&headers, &etag) {
-        let mut r = StatusCode::NOT_MODIFIED.into_response();
-        r.headers_mut().insert(header::ETAG, etag_value);
-        r.headers_mut().insert(header::CACHE_CONTROL, cache);
-        return Ok(r);
+        return Ok(crate::imagery_api::not_modified(etag_value));
     }
     let body = served.body(&state, stride).await?;
     let (w, h) = (served.axes.width.div_ceil(stride), served.axes.height.div_ceil(stride));
