@@ -26,18 +26,10 @@ export interface ReliefInfo {
 }
 
 /** The grid as served at a stride: its axes, and how rows past its ends are treated. */
-export interface ReliefGrid {
-  width: number;
-  height: number;
-  lonFirst: number;
-  lonStep: number;
-  latFirst: number;
-  latStep: number;
-  wraps: boolean;
+export interface ReliefGrid extends Omit<ReliefInfo, 'url' | 'digest'> {
   /** A global grid whose southern (northern) row lies within one step of the pole: beyond it, that row's values. */
   clampSouth: boolean;
   clampNorth: boolean;
-  scale: number;
 }
 
 /** A malformed `relief` block or grid. */

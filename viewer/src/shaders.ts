@@ -269,13 +269,11 @@ vec3 pmcGround(float h, vec3 up, float slope, float t, float jit, float m1, floa
   c = mix(c, pmcMat(9, t), ice * gentle);
   return c;
 }
-// The picture's colour at the unit direction up (linear RGB), its weight in .a (0 outside the
-// extent). Longitude per pixel, modulo 360 into the extent; the texture's gradients taken from
+// The picture's colour at latitude lat and longitude lon (radians, of the unit direction up as
+// main computes them) (linear RGB), its weight in .a (0 outside the extent). Longitude per pixel, modulo 360 into the extent; the texture's gradients taken from
 // whichever of two longitude origins has no wrap inside the pixel's quad (no seam at the
 // antimeridian).
-vec4 pmcImagery(vec3 up) {
-  float lat = asin(clamp(up.y, -1.0, 1.0));
-  float lon = atan(up.x, up.z);
+vec4 pmcImagery(float lat, float lon) {
   float span = uImageryExtent.y - uImageryExtent.x;
   float u = mod(lon - uImageryExtent.x, 2.0 * PI) / span;
   float u2 = mod(lon - uImageryExtent.x + PI, 2.0 * PI) / span;
@@ -292,12 +290,11 @@ vec4 pmcImagery(vec3 up) {
   vec3 c = textureGrad(uImagery, vec2(u, v), gx, gy).rgb;
   return vec4(c, inside);
 }
-// The relief's height (metres above the datum) at the unit direction up, bilinear in column and
-// row as relief.ts's reliefHeightAt; .y 1 on the grid, 0 off a regional one; .z the cosine of its
-// slope (from the bilinear patch's gradient, metres per metre along the parallel and the meridian).
-vec4 pmcRelief(vec3 up) {
-  float lat = asin(clamp(up.y, -1.0, 1.0));
-  float lon = atan(up.x, up.z);
+// The relief's height (metres above the datum) at latitude lat and longitude lon (radians),
+// bilinear in column and row as relief.ts's reliefHeightAt; .y 1 on the grid, 0 off a regional
+// one; .z the cosine of its slope (from the bilinear patch's gradient, metres per metre along the
+// parallel and the meridian).
+vec4 pmcRelief(float lat, float lon) {
   float w = uReliefGrid.x;
   float h = uReliefGrid.y;
   float x = mod(lon - uReliefAxes.x, 2.0 * PI) / uReliefAxes.y;
@@ -353,6 +350,9 @@ void main() {
   vec3 n = normalize(vNormal);
   vec3 up = normalize(vUp);
   float slope = dot(n, up);
+  // the place's latitude and longitude, for the relief and the imagery
+  float lat = asin(clamp(up.y, -1.0, 1.0));
+  float lon = atan(up.x, up.z);
   // The pixel's footprint, metres: its distance times the angle a pixel subtends (the change of
   // the view ray's direction from one pixel to the next, whatever the surface's orientation). It
   // depends on the view alone, never on the triangles drawn, so every filter below gives a place
@@ -368,7 +368,7 @@ void main() {
   float h = vHeight;
   float slopeWeight = 1.0 - smoothstep(0.1, 1.0, metresPerPixel * 2.0 * uNoiseFreq);
   if (uHasRelief > 0.5) {
-    vec4 relief = pmcRelief(up);
+    vec4 relief = pmcRelief(lat, lon);
     float far = smoothstep(0.02, 0.08, metresPerPixel / max(uReliefScale.y, 1e-3)) * relief.y;
     h = mix(h, relief.x, far);
     slope = mix(slope, relief.z, far);
@@ -388,7 +388,7 @@ void main() {
   vec3 base = pmcGround(h, up, slope, t, clamp(jit, -1.0, 1.0), m1, m2, slopeWeight);
   bool underwater = uHasSea > 0.5 && h < 0.0;
   // (sampled outside the branch: texture gradients need the whole pixel quad)
-  vec4 img = uHasImagery > 0.5 ? pmcImagery(up) : vec4(0.0);
+  vec4 img = uHasImagery > 0.5 ? pmcImagery(lat, lon) : vec4(0.0);
   if (uHasImagery > 0.5 && !underwater) {
     // metres per pixel against the picture's cell: below its resolution, the procedural detail
     float below = 1.0 - smoothstep(0.05, 0.5, metresPerPixel / max(uImageryCell, 1e-3));

@@ -92,17 +92,17 @@ pub(crate) fn planet_field(state: &AppState, is_default_planet: bool) -> Value {
     }
 }
 
-/// The `max` parameter of a grid or a picture (`GET /api/v1/imagery`, `/relief`): the most
-/// `units` a side may have, `u32::MAX` when absent; a 400 saying what it must be otherwise.
-pub(crate) fn max_side(params: &Params, units: &str) -> Result<u32, ApiError> {
+/// The `max` parameter of a picture or a grid (`GET /api/v1/imagery`, `/relief`): the most
+/// `units` a side of the `what` may have, `u32::MAX` when absent; a 400 saying what it must be
+/// otherwise.
+pub(crate) fn max_side(params: &Params, units: &str, what: &str) -> Result<u32, ApiError> {
     match params.get("max") {
         None => Ok(u32::MAX),
         Some(s) => match s.trim().parse::<u32>() {
             Ok(n) if n >= 1 => Ok(n),
             _ => Err(ApiError::bad_request(format!(
-                "max must be an integer from 1 to {}, the most {units} a side of the {} may have, got '{s}'",
-                u32::MAX,
-                if units == "pixels" { "image" } else { "grid" }
+                "max must be an integer from 1 to {}, the most {units} a side of the {what} may have, got '{s}'",
+                u32::MAX
             ))),
         },
     }
@@ -143,7 +143,7 @@ pub async fn imagery(
     };
     let params = Params::parse(q);
     let img = served.imagery();
-    let max = max_side(&params, "pixels")?;
+    let max = max_side(&params, "pixels", "image")?;
     let size = img.level_size(max);
     let etag = if size == (img.width(), img.height()) {
         format!("\"{}\"", img.digest())

@@ -163,11 +163,6 @@ impl ServedRelief {
         &self.digest
     }
 
-    /// Whether this is an elevation model's source grid (not a preset's ground).
-    pub fn is_dem(&self) -> bool {
-        matches!(self.source, Source::Dem(_))
-    }
-
     /// The stride the grid is served with for `?max=max`: the smallest power of two that brings
     /// both sides to at most `max` samples.
     pub fn stride_for(&self, max: u32) -> u32 {
@@ -322,7 +317,7 @@ pub async fn relief(
         ));
     };
     let params = Params::parse(q);
-    let max = crate::imagery_api::max_side(&params, "samples")?;
+    let max = crate::imagery_api::max_side(&params, "samples", "grid")?;
     let stride = served.stride_for(max);
     let etag = format!("\"{}-s{stride}\"", served.digest());
     let etag_value =
