@@ -350,6 +350,9 @@ void main() {
   vec3 n = normalize(vNormal);
   vec3 up = normalize(vUp);
   float slope = dot(n, up);
+  // (the imagery's rock on steep ground goes by the mesh's slope: the relief's, at full weight
+  // from afar, mixed rock into a picture coarser than the pixels, 9/255 off it in step 13)
+  float meshSlope = slope;
   // the place's latitude and longitude, for the relief and the imagery
   float lat = asin(clamp(up.y, -1.0, 1.0));
   float lon = atan(up.x, up.z);
@@ -396,7 +399,7 @@ void main() {
     float s = clamp(3.0 * (scales - 0.5), -1.0, 1.0);
     vec3 tint = s < 0.0 ? mix(vec3(1.0), vec3(0.78, 0.92, 0.74), -s) : mix(vec3(1.0), vec3(1.2, 1.12, 0.94), s);
     vec3 draped = img.rgb * mix(vec3(1.0), tint * (1.0 + 0.4 * (t - 0.5)), below);
-    float steep = 1.0 - smoothstep(uMatSlopes.x - 0.06, uMatSlopes.x + 0.06, slope);
+    float steep = 1.0 - smoothstep(uMatSlopes.x - 0.06, uMatSlopes.x + 0.06, meshSlope);
     draped = mix(draped, pmcMat(6, t), 0.6 * steep * below);
     base = mix(base, draped, img.a);
   }
