@@ -6,7 +6,7 @@ import type { PlanetInfo, Vec3Tuple } from './api';
 import type { PlanetShape } from './cameraModel';
 import type { PlanetExtent } from './chunkSelection';
 import { materialModel, type MaterialModel } from './materials';
-import { NOISE_PERIOD_CELLS } from './shaders';
+import { JITTER_SCALE, NOISE_PERIOD_CELLS } from './shaders';
 
 /** Wavelength of the finest place noise's first octave (detail near the ground), metres. */
 export const DETAIL_WAVELENGTH = 4;
@@ -64,7 +64,8 @@ export function planetParams(p: PlanetInfo): PlanetParams {
     snowAmount: sea !== null ? 1 : 0.3,
     waterScale: sea !== null ? Math.max(2, (sea - lowest) / 3) : 1,
     noiseFreq,
-    noisePeriod: NOISE_PERIOD_CELLS / noiseFreq,
+    // a period of every octave of the place noise, its lowest (the jitter's) included
+    noisePeriod: NOISE_PERIOD_CELLS / (JITTER_SCALE * noiseFreq),
     detailFreq,
     detailPeriod: NOISE_PERIOD_CELLS / detailFreq,
     macroFreq: datum / Math.max(1e-3, 40 * tile),

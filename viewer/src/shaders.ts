@@ -58,6 +58,15 @@ centroid varying float vFragDepth;
 export const NOISE_PERIOD_CELLS = 289;
 
 /**
+ * The place noise's lowest octave, relative to its frequency (the material lines' jitter). The
+ * chunk origins are taken modulo a period of the place noise (planetParams.ts) that this octave's
+ * lattice repeats over too: with the period of the first octave alone, a quarter of it wrapped
+ * 72.25 cells of the jitter's lattice, which then differed from chunk to chunk, and the shore's
+ * and the snow's lines moved when a place's level changed (ΔE 28, step 14).
+ */
+export const JITTER_SCALE = 0.25;
+
+/**
  * The sea surface over what lies below it (`below`, linear RGB) at unit normal `n` seen along unit
  * `v` (toward the eye): the surface's colour and sky reflection (Fresnel) and the sun's glint,
  * blended over `below` by the surface's opacity (nearly clear looking down, opaque at grazing
@@ -377,12 +386,16 @@ void main() {
     slope = mix(slope, relief.z, far);
     slopeWeight = mix(slopeWeight, 1.0, far);
   }
-  // the place's noises: fixed frequencies of the planet, filtered by the pixel's footprint
-  float meso = pmcFiltered(vNoisePos, 6, metresPerPixel * uNoiseFreq);
-  float jit = 2.0 * (pmcFiltered(vNoisePos * 0.25 + 31.0, 3, 0.25 * metresPerPixel * uNoiseFreq) - 0.5) * 2.0;
+  // the place's noises: fixed frequencies of the planet, filtered by the pixel's footprint, at
+  // the height the materials go by (the mesh's moved up or down to the relief's): a coarse
+  // level's surface lies metres under a fine one's, and the noise of the mesh's own place moved
+  // the snow line's jitter with the level drawn (ΔE 27 at a snow patch's edge, step 14)
+  vec3 noisePos = vNoisePos + up * ((h - vHeight) * uNoiseFreq);
+  float meso = pmcFiltered(noisePos, 6, metresPerPixel * uNoiseFreq);
+  float jit = 2.0 * (pmcFiltered(noisePos * ${JITTER_SCALE.toFixed(4)} + 31.0, 3, ${JITTER_SCALE.toFixed(4)} * metresPerPixel * uNoiseFreq) - 0.5) * 2.0;
   float m1 = pmcFiltered(up * uMacroFreq, 4, metresPerPixel * uMacroFreq / max(uDatum, 1.0));
   float m2 = pmcFiltered(up * (0.31 * uMacroFreq) + 53.0, 4, 0.31 * metresPerPixel * uMacroFreq / max(uDatum, 1.0));
-  float detail = pmcFiltered(vDetailPos, 4, metresPerPixel * uDetailFreq);
+  float detail = pmcFiltered(vDetailPos + up * ((h - vHeight) * uDetailFreq), 4, metresPerPixel * uDetailFreq);
   // variation from the picture's cells (or 0.3 % of the radius: 19 km on the Earth) down to 6 m,
   // where the tile-sized noise above is too fine to see and the picture too coarse
   float firstCell = uHasImagery > 0.5 ? uImageryCell : 0.003 * uDatum;

@@ -1,6 +1,7 @@
 import { describe, expect, it } from 'vitest';
 import type { PlanetInfo } from '../src/api';
 import { planetParams } from '../src/planetParams';
+import { JITTER_SCALE, NOISE_PERIOD_CELLS } from '../src/shaders';
 
 const base: PlanetInfo = {
   format: 'pmc-planet', version: 1, preset: 'earthlike', seed: '7', presets: [],
@@ -19,7 +20,9 @@ describe('planetParams', () => {
     expect(p.snowHeight).toBeGreaterThan(0);
     expect(p.snowHeight).toBeLessThan(p.bandHeight);
     expect(p.waterScale).toBeCloseTo((1884.8 - 1810.6) / 3, 9);
-    expect(p.noisePeriod * p.noiseFreq).toBeCloseTo(289, 9);
+    // a whole number of periods of every octave's lattice, the jitter's (a quarter of the
+    // frequency) included: chunk origins taken modulo it keep the noise continuous
+    expect(p.noisePeriod * p.noiseFreq * JITTER_SCALE).toBeCloseTo(NOISE_PERIOD_CELLS, 9);
   });
 
   it('uses the middle of the shell without a sea and the shell without surface bounds', () => {
