@@ -344,14 +344,22 @@ vec4 pmcRelief(float lat, float lon) {
 void main() {
   #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
   gl_FragDepth = log2(vFragDepth) * logDepthBufFC * 0.5;
+  // the depth's change from this pixel to the next (outside the branch below: derivatives need
+  // the whole pixel quad)
+  float depthSlope = fwidth(gl_FragDepth);
   #endif
   if (uBackfaceFlag > 0.5 && !gl_FrontFacing) {
     #ifdef USE_LOGARITHMIC_DEPTH_BUFFER
     // 0.2 % farther: where a back face meets a front face at a silhouette (the same edge, the
     // same depth) the front face wins; the inside seen through a crack is far behind anyway.
     // (three.js's define; under its former name, USE_LOGDEPTHBUF, this offset was compiled out
-    // and back faces won half the samples along every silhouette in the test mode)
-    gl_FragDepth = min(1.0, gl_FragDepth + log2(1.002) * logDepthBufFC * 0.5);
+    // and back faces won half the samples along every silhouette in the test mode.) And two
+    // pixels' depth slope farther (a slope-scaled offset, as polygon offset's factor): a fragment
+    // writes one depth, its centroid's, for all its antialiasing samples, and where the ground
+    // is seen edge-on (a ridge's silhouette from 50 m) the depth changes by more than 0.2 %
+    // inside one pixel, and a back face behind the silhouette won a sample of it (a tinted pixel
+    // in step 9's 50 m view; none since)
+    gl_FragDepth = min(1.0, gl_FragDepth + log2(1.002) * logDepthBufFC * 0.5 + 2.0 * depthSlope);
     #endif
     gl_FragColor = vec4(1.0, 0.0, 1.0, 1.0);
     return;
