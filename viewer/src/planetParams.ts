@@ -28,7 +28,10 @@ export interface PlanetParams {
   /** The detail noise near the ground: cycles per metre and period in metres. */
   detailFreq: number;
   detailPeriod: number;
-  /** The large-scale noise (forests, deserts): cells per unit of direction (about 40 tiles each). */
+  /**
+   * The large-scale noise (forests, deserts): cells per unit of direction, each 40 tiles or
+   * MACRO_CELL_SHARE of the radius, whichever is larger.
+   */
   macroFreq: number;
   /** The material model: one function of the place, this planet's parameters. */
   materials: MaterialModel;
@@ -40,6 +43,14 @@ export interface PlanetParams {
 }
 
 const luminance = (c: Vec3Tuple): number => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+
+/**
+ * The smallest cell of the large-scale noise, as a share of the radius: forests and deserts come
+ * in regions of 127 km and more on the Earth. At true scale 40 tiles were 80 m, and from 10 km
+ * the lowlands were a camouflage of sand and forest patches a few hundred metres across (the
+ * gallery's `earth-10000m`); on the small planets 40 tiles are larger and stay.
+ */
+export const MACRO_CELL_SHARE = 0.02;
 
 export function planetParams(p: PlanetInfo): PlanetParams {
   const sea = p.sea_radius;
@@ -68,7 +79,7 @@ export function planetParams(p: PlanetInfo): PlanetParams {
     noisePeriod: NOISE_PERIOD_CELLS / (JITTER_SCALE * noiseFreq),
     detailFreq,
     detailPeriod: NOISE_PERIOD_CELLS / detailFreq,
-    macroFreq: datum / Math.max(1e-3, 40 * tile),
+    macroFreq: datum / Math.max(1e-3, 40 * tile, MACRO_CELL_SHARE * datum),
     materials: materialModel(p, datum),
     paletteA: norm(p.palette.a),
     paletteB: norm(p.palette.b),

@@ -1,6 +1,6 @@
 import { describe, expect, it } from 'vitest';
 import type { PlanetInfo } from '../src/api';
-import { planetParams } from '../src/planetParams';
+import { MACRO_CELL_SHARE, planetParams } from '../src/planetParams';
 import { JITTER_SCALE, NOISE_PERIOD_CELLS } from '../src/shaders';
 
 const base: PlanetInfo = {
@@ -23,6 +23,15 @@ describe('planetParams', () => {
     // a whole number of periods of every octave's lattice, the jitter's (a quarter of the
     // frequency) included: chunk origins taken modulo it keep the noise continuous
     expect(p.noisePeriod * p.noiseFreq * JITTER_SCALE).toBeCloseTo(NOISE_PERIOD_CELLS, 9);
+  });
+
+  it('makes the cells of the large-scale noise at least a fiftieth of the radius', () => {
+    // the default planet: 40 tiles (8 chunks of 32 tiles over a quarter of a 1.9 km radius)
+    const small = planetParams(base);
+    expect(small.macroFreq).toBeCloseTo(1884.8 / (40 * ((Math.PI / 2) * 1884.8) / 8 / 32), 9);
+    // at the Earth's size with tiles of a metre: a fiftieth of the radius, not 40 m
+    const earth = planetParams({ ...base, radius: 6.38e6, base_radius: 6.36e6, sea_radius: 6.371e6, surface_bounds: [6.36e6, 6.38e6], layout: { ...base.layout, n_c: 2 ** 20, n_t: 16 } });
+    expect(earth.macroFreq).toBeCloseTo(1 / MACRO_CELL_SHARE, 9);
   });
 
   it('uses the middle of the shell without a sea and the shell without surface bounds', () => {
