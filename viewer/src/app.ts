@@ -11,14 +11,16 @@ import { CameraController, type PickResult } from './cameraController';
 import { ChunkStreamer } from './chunkStreamer';
 import { formatLevels } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
-import { toolByName, toolForKey, type ToolName } from './editTools';
+import { toolByName, type ToolName } from './editTools';
+import { planetName } from './planetName';
+import { shortcutOf } from './shortcuts';
 import { length, normalize, type V3 } from './frames';
 import { FrameLoop } from './frameLoop';
 import { Input, type InputFrame } from './input';
 import { LodSelector } from './lodSelector';
 import { NavGridLoader, groundPoint, navRange } from './navOverlay';
 import { NavScene } from './navScene';
-import { PATH_TOOL, PathTool, type PathStatus } from './pathTool';
+import { PathTool, type PathStatus } from './pathTool';
 import { planetParams, type PlanetParams } from './planetParams';
 import { parseImagery, loadImageryTexture, type ImageryInfo } from './imagery';
 import { parseRelief, type ReliefGrid } from './relief';
@@ -74,6 +76,8 @@ export class App implements TestHookTarget {
   private choice: { preset?: string; seed?: string } = {};
   /** The name of the elevation-model planet the server serves, once seen. */
   private servedTerrain: string | null = null;
+  /** The planet's name as the panel and the title show it (planetName.ts). */
+  private planetTitle = '–';
   private planetRequest = 0;
   private planetBusy: string | null = null;
 
@@ -181,7 +185,7 @@ export class App implements TestHookTarget {
       {
         params: () => this.params,
         busy: () => this.planetBusy,
-        planetLabel: () => `${this.choice.preset ?? '?'} · seed ${this.choice.seed ?? '?'}`,
+        planetLabel: () => this.planetTitle,
         brush: (input) => this.brushFrame(input),
         navigation: (pos, params) => this.navFrame(pos, params),
         editStats: () => {
@@ -285,6 +289,8 @@ export class App implements TestHookTarget {
 
   private applyPlanet(info: PlanetInfo): void {
     this.params = planetParams(info);
+    this.planetTitle = planetName(info);
+    document.title = `${this.planetTitle} — PMC`;
     // An elevation-model planet has no preset: it is the server's own planet, asked for with
     // no preset parameter (the picker lists it under the empty value).
     if (info.preset === null) this.servedTerrain = info.terrain?.name ?? 'elevation model';
@@ -391,44 +397,52 @@ export class App implements TestHookTarget {
 
   /** Editing shortcuts (outside text fields); true when `e` was one. */
   private shortcut(e: KeyboardEvent): boolean {
-    const mod = e.ctrlKey || e.metaKey;
-    if (mod) {
-      if (e.altKey || !this.editor.enabled) return false;
-      if (e.code === 'KeyZ') {
-        if (!e.repeat) void (e.shiftKey ? this.editor.redo() : this.editor.undo());
+    const s = shortcutOf(e);
+    if (s === null) return false;
+    switch (s.action) {
+      case 'undo':
+      case 'redo':
+        if (!this.editor.enabled) return false;
+        if (!e.repeat) void (s.action === 'redo' ? this.editor.redo() : this.editor.undo());
         return true;
-      }
-      if (e.code === 'KeyY' && !e.shiftKey) {
-        if (!e.repeat) void this.editor.redo();
+      case 'escape':
+        // Esc closes the help, clears the path (the tool stays), then goes back to Look
+        if (this.ui.helpShown) {
+          this.ui.toggleHelp(false);
+          return true;
+        }
+        if (this.pathTool.active) {
+          this.pathTool.clear();
+          return true;
+        }
+        if (this.editor.currentTool === 'look' && !this.pathActive) return false;
+        this.chooseTool('look');
         return true;
-      }
-      return false;
+      case 'path':
+        this.choosePathTool();
+        return true;
+      case 'navgrid':
+        if (!e.repeat) this.setNavGrid(!this.navLoader.enabled);
+        return true;
+      case 'tool':
+        if (s.tool === 'look' && this.editor.currentTool === 'look' && !this.pathActive) return false;
+        this.chooseTool(s.tool!);
+        return true;
+      case 'radius-down':
+      case 'radius-up':
+        if (!this.editor.enabled) return false;
+        this.editor.stepRadius(s.action === 'radius-up' ? 1 : -1);
+        return true;
+      case 'overlays':
+        if (!e.repeat) this.ui.toggleOverlays();
+        return true;
+      case 'help':
+        if (!e.repeat) this.ui.toggleHelp();
+        return true;
+      default:
+        // the camera's keys (input.ts)
+        return false;
     }
-    if (e.altKey) return false;
-    if (e.code === 'Escape' && this.pathTool.active) {
-      // Esc clears the path first (the tool stays), then goes back to Look
-      this.pathTool.clear();
-      return true;
-    }
-    if (e.code === PATH_TOOL.code) {
-      this.choosePathTool();
-      return true;
-    }
-    if (e.code === 'KeyN' && !e.shiftKey) {
-      if (!e.repeat) this.setNavGrid(!this.navLoader.enabled);
-      return true;
-    }
-    const tool = toolForKey(e.code);
-    if (tool) {
-      if (tool === 'look' && this.editor.currentTool === 'look' && !this.pathActive) return false;
-      this.chooseTool(tool);
-      return true;
-    }
-    if ((e.code === 'BracketLeft' || e.code === 'BracketRight') && this.editor.enabled) {
-      this.editor.stepRadius(e.code === 'BracketRight' ? 1 : -1);
-      return true;
-    }
-    return false;
   }
 
   /** An editing tool (or Look) from the tool bar or its key; leaves the Path tool. */

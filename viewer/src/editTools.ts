@@ -31,16 +31,18 @@ export const TOOLS: readonly ToolDef[] = [
   { name: 'paint', label: 'Paint', brush: 'paint', code: 'Digit6', key: '6', colour: [0.9, 0.45, 1], help: 'paint the surface with the chosen material' },
 ];
 
+/** The tool-bar entry of the Path tool (next to Look, Dig ... whose hotkeys are 1-6; pathTool.ts). */
+export const PATH_TOOL = {
+  label: 'Path',
+  code: 'Digit7',
+  key: '7',
+  help: 'click two points of the terrain: the walking path between them (no world needed)',
+} as const;
+
 export function toolByName(name: ToolName): ToolDef {
   const t = TOOLS.find((t) => t.name === name);
   if (!t) throw new Error(`unknown tool ${name}`);
   return t;
-}
-
-/** The tool whose hotkey is `code` (a `KeyboardEvent.code`), or null. Escape is Look. */
-export function toolForKey(code: string): ToolName | null {
-  if (code === 'Escape') return 'look';
-  return TOOLS.find((t) => t.code === code)?.name ?? null;
 }
 
 export const DEFAULT_RADIUS = 4;

@@ -1,5 +1,7 @@
 // Mouse, wheel and keyboard input on the canvas, turned into deltas the app consumes each frame.
 
+import { SHORTCUTS, heldCodes, shortcutOf } from './shortcuts';
+
 export interface InputFrame {
   /** Pointer drag (or pointer-lock motion) since the last frame, pixels. */
   dragX: number;
@@ -19,17 +21,17 @@ export interface InputFrame {
   brushRelease: boolean;
 }
 
-const FORWARD = new Set(['KeyW', 'ArrowUp']);
-const BACK = new Set(['KeyS', 'ArrowDown']);
-const LEFT = new Set(['KeyA', 'ArrowLeft']);
-const RIGHT = new Set(['KeyD', 'ArrowRight']);
-const UP = new Set(['KeyE', 'Space', 'PageUp']);
-const DOWN = new Set(['KeyQ', 'ShiftLeft', 'ShiftRight', 'PageDown']);
+const FORWARD = heldCodes('forward');
+const BACK = heldCodes('back');
+const LEFT = heldCodes('left');
+const RIGHT = heldCodes('right');
+const UP = heldCodes('up');
+const DOWN = heldCodes('down');
+const FAST = heldCodes('fast');
 /** Every key this module gives a meaning to (other shortcuts must not use them). */
-export const BOUND_KEYS: ReadonlySet<string> = new Set([
-  ...FORWARD, ...BACK, ...LEFT, ...RIGHT, ...UP, ...DOWN,
-  'Tab', 'KeyG', 'ControlLeft', 'AltLeft',
-]);
+export const BOUND_KEYS: ReadonlySet<string> = new Set(
+  SHORTCUTS.filter((s) => s.held || s.action === 'mode' || s.action === 'walk').flatMap((s) => s.codes),
+);
 
 export interface InputCallbacks {
   /** Tab: switch between orbit and fly. */
@@ -133,13 +135,14 @@ export class Input {
         e.preventDefault();
         return;
       }
-      if (e.code === 'Tab') {
+      const action = shortcutOf(e)?.action;
+      if (action === 'mode') {
         e.preventDefault();
         this.callbacks.onToggleMode();
         return;
       }
-      if (e.code === 'KeyG' && !e.repeat) {
-        this.callbacks.onToggleWalk();
+      if (action === 'walk') {
+        if (!e.repeat) this.callbacks.onToggleWalk();
         return;
       }
       if (e.code === 'Space' || e.code.startsWith('Arrow') || e.code.startsWith('Page')) {
@@ -200,7 +203,7 @@ export class Input {
   take(): InputFrame {
     // with Ctrl (or Cmd) held, Shift is part of a shortcut (Ctrl+Shift+Z: redo), not "down"
     const chord = ['ControlLeft', 'ControlRight', 'MetaLeft', 'MetaRight'].some((k) => this.held.has(k));
-    const axis = (pos: Set<string>, neg: Set<string>): number => {
+    const axis = (pos: ReadonlySet<string>, neg: ReadonlySet<string>): number => {
       let v = 0;
       for (const k of this.held) {
         if (chord && (k === 'ShiftLeft' || k === 'ShiftRight')) continue;
@@ -216,7 +219,7 @@ export class Input {
       forward: axis(FORWARD, BACK),
       right: axis(RIGHT, LEFT),
       up: axis(UP, DOWN),
-      fast: this.held.has('ControlLeft') || this.held.has('AltLeft'),
+      fast: [...FAST].some((k) => this.held.has(k)),
       brushPress: this.brushPresses[0] ?? null,
       brushPresses: this.brushPresses,
       brushRelease: this.brushRelease,

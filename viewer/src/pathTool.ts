@@ -8,13 +8,8 @@ import type { V3 } from './frames';
 import { formatPathEnd, navErrorMessage, pathEndOf, pointOfEnd } from './navOverlay';
 import { formatDistance } from './ui';
 
-/** The tool-bar entry of the Path tool (next to Look, Dig ... whose hotkeys are 1-6). */
-export const PATH_TOOL = {
-  label: 'Path',
-  code: 'Digit7',
-  key: '7',
-  help: 'click two points of the terrain: the walking path between them (no world needed)',
-} as const;
+/** The tool-bar entry of the Path tool (defined with the other tools: editTools.ts). */
+export { PATH_TOOL } from './editTools';
 
 /**
  * empty: no end set; start: the start is set, the goal is awaited; loading: both set, the path

@@ -6,6 +6,7 @@ import type { CameraMode } from './cameraModel';
 import type { PresetInfo } from './api';
 import type { DebugFlags } from './planetScene';
 import type { NavGridStatus } from './navOverlay';
+import { MOUSE_HELP, SHORTCUTS, SHORTCUT_GROUPS } from './shortcuts';
 
 export interface UiCallbacks {
   onPlanet(preset: string, seed: string): void;
@@ -98,6 +99,8 @@ export class Ui {
   private mode: CameraMode = 'orbit';
 
   constructor(private readonly callbacks: UiCallbacks) {
+    this.renderKeysHelp();
+    byId<HTMLButtonElement>('keys-help-close').addEventListener('click', () => this.toggleHelp(false));
     byId<HTMLFormElement>('planet-form').addEventListener('submit', (e) => {
       e.preventDefault();
       this.submitPlanet();
@@ -262,6 +265,45 @@ export class Ui {
       this.loadingText.textContent =
         busyText ?? `loading ${pending + missing} chunk${pending + missing === 1 ? '' : 's'}`;
     }
+  }
+
+  /** Whether the keyboard help shows. */
+  get helpShown(): boolean {
+    return !byId<HTMLElement>('keys-help').hidden;
+  }
+
+  /** Shows the keyboard help (`?`), or hides it; toggles when `show` is not given. Returns whether it shows. */
+  toggleHelp(show?: boolean): boolean {
+    const help = byId<HTMLElement>('keys-help');
+    help.hidden = !(show ?? help.hidden);
+    return !help.hidden;
+  }
+
+  /** Hides every overlay but an error (`H`: the planet alone), or shows them; toggles when not given. */
+  toggleOverlays(hidden?: boolean): boolean {
+    const on = hidden ?? !document.body.classList.contains('overlays-hidden');
+    document.body.classList.toggle('overlays-hidden', on);
+    return on;
+  }
+
+  /** The keyboard help, from the table the handlers use (shortcuts.ts): one row per shortcut. */
+  private renderKeysHelp(): void {
+    const body = byId<HTMLElement>('keys-help-body');
+    const section = (title: string, rows: readonly { keys: string; what: string }[]): void => {
+      const h = document.createElement('h3');
+      h.textContent = title;
+      const table = document.createElement('table');
+      for (const r of rows) {
+        const tr = table.insertRow();
+        const th = document.createElement('th');
+        th.textContent = r.keys;
+        tr.appendChild(th);
+        tr.insertCell().textContent = r.what;
+      }
+      body.append(h, table);
+    };
+    for (const g of SHORTCUT_GROUPS) section(g, SHORTCUTS.filter((s) => s.group === g));
+    section('Mouse', MOUSE_HELP);
   }
 
   showError(message: string): void {

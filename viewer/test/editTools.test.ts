@@ -9,10 +9,10 @@ import {
   editRequest,
   resolveMaterial,
   stepRadius,
-  toolForKey,
 } from '../src/editTools';
 import type { V3 } from '../src/frames';
 import { BOUND_KEYS } from '../src/input';
+import { shortcutOf } from '../src/shortcuts';
 
 const EDIT: EditEnabled = {
   enabled: true, world: 'w.pmcw', revision: 0, active: 0, redo: 0,
@@ -30,15 +30,16 @@ describe('tools', () => {
 
   it('have hotkeys 1-6 (Escape: look) that clash with no key of input.ts', () => {
     expect(TOOLS.map((t) => t.code)).toEqual(['Digit1', 'Digit2', 'Digit3', 'Digit4', 'Digit5', 'Digit6']);
+    const key = (code: string) => shortcutOf({ code, key: '', ctrlKey: false, metaKey: false, altKey: false, shiftKey: false });
     for (const t of TOOLS) {
       expect(BOUND_KEYS.has(t.code)).toBe(false);
-      expect(toolForKey(t.code)).toBe(t.name);
+      expect(key(t.code)?.tool).toBe(t.name);
     }
     expect(BOUND_KEYS.has('KeyW') && BOUND_KEYS.has('Tab') && BOUND_KEYS.has('KeyG')).toBe(true);
     for (const k of ['Escape', 'BracketLeft', 'BracketRight', 'KeyZ', 'KeyY']) expect(BOUND_KEYS.has(k)).toBe(false);
-    expect(toolForKey('Escape')).toBe('look');
-    expect(toolForKey('KeyW')).toBeNull();
-    expect(toolForKey('Digit7')).toBeNull();
+    expect(key('Escape')?.action).toBe('escape');
+    expect(key('KeyW')).toBeNull();
+    expect(key('Digit7')?.action).toBe('path');
   });
 });
 

@@ -45,6 +45,11 @@ export async function scenario(t) {
   const planet = await hook(() => fetch('api/v1/planet').then((x) => x.json()));
   check(planet.terrain?.kind === 'dem' && planet.terrain.file === 'earth.pmcdem', `the planet is ${JSON.stringify(planet.terrain)}`);
   check(planet.materials.includes('deep seabed') && planet.materials.includes('shelf'), `materials ${planet.materials}`);
+  // named by its world, its file and its body, in the panel and the title
+  const named = 'earth.pmcw · earth.pmcdem · the Earth';
+  await page.waitForFunction((n) => document.getElementById('s-planet')?.textContent === n, named, { timeout: 10_000 }).catch(() => undefined);
+  const shown = [await page.textContent('#s-planet'), await page.title()];
+  check(shown[0] === named && shown[1].startsWith(named), `the planet is named ${JSON.stringify(shown)}, not "${named}"`);
   await hook(() => window.__pmc.mode('orbit'));
   await hook(() => window.__pmc.setCamera(30, 127, 3_000_000, 0, -90));
   await ready('over the East China Sea');

@@ -1,9 +1,9 @@
-// Step 6: debug views, mode switch, walk mode and the URL hash.
+// Step 6: debug views, mode switch, walk mode, the URL hash, the keyboard help (?) and H.
 
 import { check, log } from '../harness.mjs';
 import { fractionDifferent } from '../images.mjs';
 
-export const name = '6. debug views, mode switch, walk mode and the URL hash';
+export const name = '6. debug views, mode switch, walk mode, the URL hash, the keyboard help and hiding the panels';
 
 export async function scenario(t) {
   const { page, consoleProblems, expectedFailures, hook, ready, shot } = t;
@@ -69,5 +69,28 @@ export async function scenario(t) {
   check((await page.inputValue('#preset')) === 'earthlike', 'the preset picker does not show the current planet');
   await page.click('#error-close');
   check(await page.isHidden('#error'), 'the error banner does not close');
+
+  // the planet named in the panel and the title
+  const shownName = [await page.textContent('#s-planet'), await page.title()];
+  check(shownName[0] === 'earthlike · seed 7' && shownName[1] === 'earthlike · seed 7 — PMC', `the planet is named ${JSON.stringify(shownName)}`);
+
+  // ? shows every shortcut (from the table the handlers use), Esc closes it; H hides every panel
+  await page.click('#view');
+  check(await page.isHidden('#keys-help'), 'the keyboard help shows before ? is pressed');
+  await page.keyboard.press('Shift+Slash');
+  check(await page.isVisible('#keys-help'), 'the keyboard help does not show on ?');
+  const rows = await page.$$eval('#keys-help th', (ths) => ths.map((th) => th.textContent));
+  log(`  keyboard help: ${rows.length} rows: ${rows.join(' | ')}`);
+  for (const k of ['W / ↑', 'Tab', 'G', '1', '7', 'Esc', 'Ctrl+Z', 'Ctrl+Shift+Z', 'N', 'H', '?', 'wheel']) {
+    check(rows.includes(k), `the keyboard help lacks ${k}`);
+  }
+  await page.keyboard.press('Escape');
+  check(await page.isHidden('#keys-help'), 'Esc does not close the keyboard help');
+  const panels = () => page.$$eval('.panel:not(#keys-help)', (els) => els.map((el) => getComputedStyle(el).display));
+  check((await panels()).every((d) => d !== 'none'), 'a panel is hidden before H');
+  await page.keyboard.press('KeyH');
+  check((await panels()).every((d) => d === 'none'), `H leaves panels shown: ${await panels()}`);
+  await page.keyboard.press('KeyH');
+  check((await panels()).every((d) => d !== 'none'), 'a second H does not bring the panels back');
   check(consoleProblems.length === 0, `console messages:\n  ${consoleProblems.join('\n  ')}`);
 }

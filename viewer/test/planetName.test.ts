@@ -1,0 +1,47 @@
+import { describe, expect, it } from 'vitest';
+import type { PlanetInfo } from '../src/api';
+import { bodyOfRadius, planetName } from '../src/planetName';
+
+const preset: PlanetInfo = {
+  format: 'pmc-planet', version: 1, preset: 'earthlike', seed: '7', presets: [],
+  layout: { n_c: 8, n_t: 32, d_b: 1744, l_d: 4, d_c: 2 },
+  radius: 2000, base_radius: 1744, sea_radius: 1884.8, surface_bounds: [1810.6, 1995.5],
+  chunk_count: 768, face_tiles: 256, depth_tiles: 64, faces: [], materials: [],
+  palette: { a: [0.8, 0.7, 0.5], b: [0.3, 0.5, 0.2] },
+};
+
+describe('planet names', () => {
+  it('names a preset by its name and seed', () => {
+    expect(planetName(preset)).toBe('earthlike · seed 7');
+  });
+
+  it('names an elevation model by its file and the body of its radius', () => {
+    const dem: PlanetInfo = {
+      ...preset,
+      preset: null,
+      seed: '0',
+      radius: 6_390_000,
+      base_radius: 6_350_000,
+      sea_radius: 6_371_000,
+      terrain: { kind: 'dem', name: 'dem:earth.pmcdem', seed: '0', file: 'earth.pmcdem' },
+    };
+    expect(planetName(dem)).toBe('earth.pmcdem · the Earth');
+    expect(planetName({ ...dem, sea_radius: null, radius: 3_400_000, base_radius: 3_380_000 })).toBe('earth.pmcdem · Mars');
+  });
+
+  it('puts the world first when the server edits one', () => {
+    const edit = {
+      enabled: true as const, world: 'my.pmcw', revision: 3, active: 3, redo: 0, min_brush_radius: 0.5,
+      max_brush_radius: 64, rate_per_second: 5, burst: 10, brushes: ['add'],
+    };
+    expect(planetName({ ...preset, edit })).toBe('my.pmcw · earthlike · seed 7');
+    expect(planetName({ ...preset, edit: { enabled: false, reason: 'no world' } })).toBe('earthlike · seed 7');
+  });
+
+  it('gives the radius when no body is that size', () => {
+    expect(bodyOfRadius(6_371_000 * 1.005)).toBe('the Earth');
+    expect(bodyOfRadius(6_371_000 * 1.05)).toBe('radius 6,690 km');
+    expect(bodyOfRadius(1884.8)).toBe('radius 1,885 m');
+    expect(bodyOfRadius(1_737_400)).toBe('the Moon');
+  });
+});
