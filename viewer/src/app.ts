@@ -12,6 +12,7 @@ import { ChunkStreamer } from './chunkStreamer';
 import { formatLevels } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
 import { toolByName, type ToolName } from './editTools';
+import { Flight, parseGoTo, type GoToTarget } from './goTo';
 import { planetName } from './planetName';
 import { shortcutOf } from './shortcuts';
 import { length, normalize, type V3 } from './frames';
@@ -78,6 +79,8 @@ export class App implements TestHookTarget {
   private servedTerrain: string | null = null;
   /** The planet's name as the panel and the title show it (planetName.ts). */
   private planetTitle = '–';
+  /** A flight of `goTo` under way. */
+  private flight: { plan: Flight; start: number } | null = null;
   private planetRequest = 0;
   private planetBusy: string | null = null;
 
@@ -126,6 +129,13 @@ export class App implements TestHookTarget {
       onNavGrid: (on) => this.setNavGrid(on),
       onLod: (settings) => this.setLod(settings),
       onSky: (settings) => void this.setSky(settings),
+      onGoTo: (text) => {
+        try {
+          this.goTo(text);
+        } catch (e) {
+          this.showError(e instanceof Error ? e.message : String(e));
+        }
+      },
     });
     this.scene.scene.add(this.navScene.group);
     this.pathTool = new PathTool({
@@ -186,6 +196,7 @@ export class App implements TestHookTarget {
         params: () => this.params,
         busy: () => this.planetBusy,
         planetLabel: () => this.planetTitle,
+        travel: (now) => this.travel(now),
         brush: (input) => this.brushFrame(input),
         navigation: (pos, params) => this.navFrame(pos, params),
         editStats: () => {
@@ -357,6 +368,39 @@ export class App implements TestHookTarget {
     }
     this.readiness.reset();
     this.writeHash(true);
+  }
+
+  /**
+   * Flies to the place the go-to box's `text` names (`LAT, LON[, ALT]`; the altitude kept when
+   * none is given): along the great circle, climbing and descending on the way. Returns the place;
+   * throws with what is wrong with the text.
+   */
+  goTo(text: string): GoToTarget {
+    const target = parseGoTo(text);
+    if ('error' in target) throw new Error(target.error);
+    if (!this.params) throw new Error('no planet yet to go to a place on');
+    // (walking would hold the camera to the ground on the way)
+    if (this.cameras.walk) this.setWalk(false);
+    const s = this.cameras.state;
+    const from = { lat: s.lat, lon: s.lon, alt: Number.isFinite(s.alt) ? s.alt : 0 };
+    const to = { lat: target.lat, lon: target.lon, alt: target.alt ?? from.alt };
+    this.flight = { plan: new Flight(from, to, this.params.shape.datum), start: performance.now() };
+    this.readiness.reset();
+    return target;
+  }
+
+  /** The camera along a flight of `goTo`, this frame (before the camera's own step). */
+  private travel(now: number): boolean {
+    if (this.flight === null) return false;
+    const t = (now - this.flight.start) / 1000;
+    const p = this.flight.plan.at(t);
+    this.cameras.setCamera(p.lat, p.lon, p.alt, undefined, undefined, this.params?.shape ?? null);
+    if (t >= this.flight.plan.duration) {
+      this.flight = null;
+      this.readiness.reset();
+      this.writeHash(true);
+    }
+    return true;
   }
 
   private applyUrlState(u: UrlState, fromUser: boolean): void {
@@ -653,6 +697,7 @@ export class App implements TestHookTarget {
     const cam = this.cameras;
     return {
       preset: this.choice.preset ?? null,
+      flying: this.flight !== null,
       seed: this.choice.seed ?? null,
       shown: st.shown,
       loaded: st.loaded,

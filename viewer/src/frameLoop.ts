@@ -36,6 +36,8 @@ export interface FrameSteps {
   busy(): string | null;
   /** The stats panel's planet line. */
   planetLabel(): string;
+  /** Moves the camera along a flight under way (before the camera's own step); true while one is. */
+  travel(now: number): boolean;
   /** The brush (or the Path tool) under the mouse, with the camera of this frame. */
   brush(input: InputFrame): void;
   /** The path and the nav grid overlay around the camera at `pos`. */
@@ -128,6 +130,7 @@ export class FrameLoop {
       return;
     }
     const shape = params.shape;
+    const flying = steps.travel(now);
     const { pos, basis, moved } = cameras.frame(input, params, dt, this.frames, (p) => {
       scene.place(p);
       scene.scene.updateMatrixWorld();
@@ -156,7 +159,7 @@ export class FrameLoop {
     if (this.redraw.shouldDraw(now, moved || inputActive(input), settled, changed)) this.draw(now);
 
     const st = streamer.stats();
-    readiness.frame(steps.busy() === null && selection.current() && settled);
+    readiness.frame(!flying && steps.busy() === null && selection.current() && settled);
     if (now - this.lastUiUpdate > 200) {
       this.lastUiUpdate = now;
       const s = cameras.state;

@@ -34,6 +34,8 @@ export interface PmcLodStats extends Omit<StreamerStats, 'loaded' | 'pending' | 
 
 export interface PmcStats {
   preset: string | null;
+  /** A flight of the go-to box under way. */
+  flying: boolean;
   seed: string | null;
   /** Chunks shown, loaded (in the cache, shown or not), pending and wanted but not asked yet. */
   shown: number;

@@ -19,6 +19,8 @@ export interface UiCallbacks {
   onLod(settings: { maxPixelError?: number; maxChunks?: number }): void;
   /** The sky fields: the atmosphere checkbox, the sun's elevation and azimuth (degrees). */
   onSky(settings: Partial<SkySettings>): void;
+  /** The go-to box's text, submitted. */
+  onGoTo(text: string): void;
 }
 
 export interface StatsView {
@@ -100,6 +102,10 @@ export class Ui {
 
   constructor(private readonly callbacks: UiCallbacks) {
     this.renderKeysHelp();
+    byId<HTMLFormElement>('goto-form').addEventListener('submit', (e) => {
+      e.preventDefault();
+      this.callbacks.onGoTo(byId<HTMLInputElement>('goto').value);
+    });
     byId<HTMLButtonElement>('keys-help-close').addEventListener('click', () => this.toggleHelp(false));
     byId<HTMLFormElement>('planet-form').addEventListener('submit', (e) => {
       e.preventDefault();

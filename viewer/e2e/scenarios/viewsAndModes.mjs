@@ -70,6 +70,38 @@ export async function scenario(t) {
   await page.click('#error-close');
   check(await page.isHidden('#error'), 'the error banner does not close');
 
+  // the go-to box: a bad place is refused with a message; a good one is flown to along an arc
+  // that climbs over both ends, and the streaming converges there
+  await page.fill('#goto', '91, 0');
+  await page.press('#goto', 'Enter');
+  const refused = await page.evaluate(() => (document.getElementById('error').hidden ? null : document.getElementById('error-text').textContent));
+  check(refused !== null && refused.includes('beyond the poles'), `no message for a latitude of 91° (banner: ${refused})`);
+  await page.click('#error-close');
+  const start = await hook(() => window.__pmc.stats());
+  await page.fill('#goto', "27°59'N 86°55'E, 300");
+  await page.press('#goto', 'Enter');
+  const way = await hook(
+    () =>
+      new Promise((resolve) => {
+        const seen = [];
+        const t0 = performance.now();
+        const poll = () => {
+          const s = window.__pmc.stats();
+          seen.push([s.lat, s.lon, s.alt, s.flying]);
+          if ((!s.flying && seen.length > 1) || performance.now() - t0 > 30_000) resolve(seen);
+          else setTimeout(poll, 100);
+        };
+        poll();
+      }),
+  );
+  const arrived = await ready('after going to 27°59\'N 86°55\'E');
+  const highest = Math.max(...way.map((w) => w[2]));
+  log(`  go-to: ${way.length} samples on the way, from ${start.alt.toFixed(0)} m to ${arrived.alt.toFixed(0)} m, highest ${highest.toFixed(0)} m; now ${arrived.lat.toFixed(4)}, ${arrived.lon.toFixed(4)}`);
+  check(way.filter((w) => w[3]).length >= 5, `the flight was a jump (${way.filter((w) => w[3]).length} samples while flying)`);
+  check(Math.abs(arrived.lat - (27 + 59 / 60)) < 1e-6 && Math.abs(arrived.lon - (86 + 55 / 60)) < 1e-6 && Math.abs(arrived.alt - 300) < 1e-6, `the flight ended at ${arrived.lat}, ${arrived.lon}, ${arrived.alt}`);
+  check(highest > Math.max(start.alt, 300) + 100, `the flight did not climb on the way (highest ${highest} m)`);
+  check(arrived.pending === 0 && arrived.shown > 0, `the streaming did not converge there: ${arrived.shown} shown, ${arrived.pending} pending`);
+
   // the planet named in the panel and the title
   const shownName = [await page.textContent('#s-planet'), await page.title()];
   check(shownName[0] === 'earthlike · seed 7' && shownName[1] === 'earthlike · seed 7 — PMC', `the planet is named ${JSON.stringify(shownName)}`);
