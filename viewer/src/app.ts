@@ -12,6 +12,7 @@ import { ChunkStreamer } from './chunkStreamer';
 import { formatLevels } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
 import { toolByName, type ToolName } from './editTools';
+import { bookmarkName, loadBookmarks, saveBookmarks, withBookmark, withoutBookmark, type Bookmark } from './bookmarks';
 import { Flight, parseGoTo, type GoToTarget } from './goTo';
 import { planetName } from './planetName';
 import { shortcutOf } from './shortcuts';
@@ -79,6 +80,8 @@ export class App implements TestHookTarget {
   private servedTerrain: string | null = null;
   /** The planet's name as the panel and the title show it (planetName.ts). */
   private planetTitle = '–';
+  /** The bookmarks of views (bookmarks.ts), as kept in local storage. */
+  private bookmarks: Bookmark[] = loadBookmarks(globalThis.localStorage);
   /** A flight of `goTo` under way. */
   private flight: { plan: Flight; start: number } | null = null;
   private planetRequest = 0;
@@ -129,6 +132,13 @@ export class App implements TestHookTarget {
       onNavGrid: (on) => this.setNavGrid(on),
       onLod: (settings) => this.setLod(settings),
       onSky: (settings) => void this.setSky(settings),
+      onBookmarkAdd: () => this.addBookmark(),
+      onBookmarkOpen: (name) => this.openBookmark(name),
+      onBookmarkRemove: (name) => {
+        this.bookmarks = withoutBookmark(this.bookmarks, name);
+        saveBookmarks(globalThis.localStorage, this.bookmarks);
+        this.ui.setBookmarks(this.bookmarks);
+      },
       onGoTo: (text) => {
         try {
           this.goTo(text);
@@ -215,6 +225,7 @@ export class App implements TestHookTarget {
     this.choice = { ...(fromHash.preset ? { preset: fromHash.preset } : {}), ...(fromHash.seed ? { seed: fromHash.seed } : {}) };
     this.ui.setMode(this.cameras.mode, this.cameras.walk);
     this.ui.setDebug(this.scene.debug());
+    this.ui.setBookmarks(this.bookmarks);
     this.ui.setLod(this.selection.settings);
     this.ui.setSky(this.scene.atmosphere.state());
     window.__pmc = createTestHook(this);
@@ -389,6 +400,28 @@ export class App implements TestHookTarget {
     return target;
   }
 
+  /** Keeps the current view as a bookmark named by its place. */
+  addBookmark(): Bookmark {
+    const s = this.cameras.state;
+    const b: Bookmark = { name: bookmarkName(s.lat, s.lon, Number.isFinite(s.alt) ? s.alt : 0), planet: this.planetTitle, hash: this.viewHash() };
+    this.bookmarks = withBookmark(this.bookmarks, b);
+    if (!saveBookmarks(globalThis.localStorage, this.bookmarks)) this.showError('The bookmark is kept for this page only: the browser refuses to store it');
+    this.ui.setBookmarks(this.bookmarks, b.name);
+    return b;
+  }
+
+  /** Goes to the bookmark named `name`: a flight on the same planet, else the view's link. */
+  openBookmark(name: string): void {
+    const b = this.bookmarks.find((x) => x.name === name);
+    if (!b) return;
+    const u = parseHash(b.hash);
+    if (b.planet === this.planetTitle && u.lat !== undefined && u.lon !== undefined) {
+      this.goTo(`${u.lat}, ${u.lon}${u.alt !== undefined ? `, ${u.alt}` : ''}`);
+    } else {
+      location.hash = b.hash;
+    }
+  }
+
   /** The camera along a flight of `goTo`, this frame (before the camera's own step). */
   private travel(now: number): boolean {
     if (this.flight === null) return false;
@@ -419,18 +452,23 @@ export class App implements TestHookTarget {
     }
   }
 
-  private writeHash(force: boolean): void {
-    const now = performance.now();
-    if (!force && now - this.lastHashWrite < 500) return;
-    this.lastHashWrite = now;
+  /** The URL hash of the view now: the planet, the mode and the camera. */
+  private viewHash(): string {
     const s = this.cameras.state;
-    const hash = formatHash({
+    return formatHash({
       ...(this.choice.preset ? { preset: this.choice.preset } : {}),
       ...(this.choice.seed ? { seed: this.choice.seed } : {}),
       mode: this.cameras.mode,
       walk: this.cameras.walk,
       ...(Number.isFinite(s.alt) ? { lat: s.lat, lon: s.lon, alt: s.alt, heading: s.heading, pitch: s.pitch } : {}),
     });
+  }
+
+  private writeHash(force: boolean): void {
+    const now = performance.now();
+    if (!force && now - this.lastHashWrite < 500) return;
+    this.lastHashWrite = now;
+    const hash = this.viewHash();
     if (hash !== this.writtenHash && hash !== location.hash) {
       this.writtenHash = hash;
       history.replaceState(null, '', hash);

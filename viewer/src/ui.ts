@@ -21,6 +21,10 @@ export interface UiCallbacks {
   onSky(settings: Partial<SkySettings>): void;
   /** The go-to box's text, submitted. */
   onGoTo(text: string): void;
+  /** Bookmarks: this view kept; one chosen (by its name); one forgotten. */
+  onBookmarkAdd(): void;
+  onBookmarkOpen(name: string): void;
+  onBookmarkRemove(name: string): void;
 }
 
 export interface StatsView {
@@ -102,6 +106,14 @@ export class Ui {
 
   constructor(private readonly callbacks: UiCallbacks) {
     this.renderKeysHelp();
+    const marks = byId<HTMLSelectElement>('bookmarks');
+    marks.addEventListener('change', () => {
+      if (marks.value !== '') this.callbacks.onBookmarkOpen(marks.value);
+    });
+    byId<HTMLButtonElement>('bookmark-add').addEventListener('click', () => this.callbacks.onBookmarkAdd());
+    byId<HTMLButtonElement>('bookmark-remove').addEventListener('click', () => {
+      if (marks.value !== '') this.callbacks.onBookmarkRemove(marks.value);
+    });
     byId<HTMLFormElement>('goto-form').addEventListener('submit', (e) => {
       e.preventDefault();
       this.callbacks.onGoTo(byId<HTMLInputElement>('goto').value);
@@ -271,6 +283,22 @@ export class Ui {
       this.loadingText.textContent =
         busyText ?? `loading ${pending + missing} chunk${pending + missing === 1 ? '' : 's'}`;
     }
+  }
+
+  /** The bookmarks' list (names, with their planets), `chosen` selected. */
+  setBookmarks(list: readonly { name: string; planet: string }[], chosen = ''): void {
+    const marks = byId<HTMLSelectElement>('bookmarks');
+    const first = document.createElement('option');
+    first.value = '';
+    first.textContent = list.length === 0 ? 'no bookmarks yet: ☆ keeps this view' : `bookmarks (${list.length})…`;
+    const options = list.map((b) => {
+      const o = document.createElement('option');
+      o.value = b.name;
+      o.textContent = `${b.name} · ${b.planet}`;
+      return o;
+    });
+    marks.replaceChildren(first, ...options);
+    marks.value = chosen;
   }
 
   /** Whether the keyboard help shows. */

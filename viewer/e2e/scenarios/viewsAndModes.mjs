@@ -102,6 +102,22 @@ export async function scenario(t) {
   check(highest > Math.max(start.alt, 300) + 100, `the flight did not climb on the way (highest ${highest} m)`);
   check(arrived.pending === 0 && arrived.shown > 0, `the streaming did not converge there: ${arrived.shown} shown, ${arrived.pending} pending`);
 
+  // a bookmark of this view: kept in local storage, flown back to from elsewhere
+  await page.click('#bookmark-add');
+  const marks = await page.$$eval('#bookmarks option', (os) => os.map((o) => o.value).filter((v) => v !== ''));
+  const stored = await page.evaluate(() => JSON.parse(localStorage.getItem('pmc.bookmarks') ?? '[]'));
+  log(`  bookmarks: ${JSON.stringify(marks)}; stored ${stored.length}`);
+  check(marks.length === 1 && stored.length === 1 && stored[0].name === marks[0] && stored[0].planet === 'earthlike · seed 7', `the bookmark was not kept: ${JSON.stringify(stored)}`);
+  const flyDone = () => page.waitForFunction(() => !window.__pmc.stats().flying, null, { timeout: 30_000, polling: 100 });
+  await page.fill('#goto', '0, 0, 500');
+  await page.press('#goto', 'Enter');
+  await flyDone();
+  await page.selectOption('#bookmarks', marks[0]);
+  await page.waitForFunction(() => window.__pmc.stats().flying, null, { timeout: 5_000, polling: 50 }).catch(() => undefined);
+  await flyDone();
+  const back = await ready('back at the bookmark');
+  check(Math.abs(back.lat - (27 + 59 / 60)) < 1e-4 && Math.abs(back.lon - (86 + 55 / 60)) < 1e-4 && Math.abs(back.alt - 300) < 0.1, `the bookmark led to ${back.lat}, ${back.lon}, ${back.alt}`);
+
   // the planet named in the panel and the title
   const shownName = [await page.textContent('#s-planet'), await page.title()];
   check(shownName[0] === 'earthlike · seed 7' && shownName[1] === 'earthlike · seed 7 — PMC', `the planet is named ${JSON.stringify(shownName)}`);
