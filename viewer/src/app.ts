@@ -43,7 +43,7 @@ import {
 import { ToolsUi } from './toolsUi';
 import { Ui, formatDistance } from './ui';
 import { formatHash, parseHash, type UrlState } from './urlState';
-import { ViewSelection, lodPlanetOf, type LodSettings } from './viewSelection';
+import { DEFAULT_LOD, ViewSelection, lodPlanetOf, type LodSettings } from './viewSelection';
 
 export class App implements TestHookTarget {
   private readonly api = new PmcApi('api/v1');
@@ -438,6 +438,11 @@ export class App implements TestHookTarget {
 
   private applyUrlState(u: UrlState, fromUser: boolean): void {
     this.cameras.applyUrlState(u, this.params?.shape ?? null);
+    if (u.px !== undefined || u.chunks !== undefined) {
+      this.selection.setSettings({ ...(u.px !== undefined ? { maxPixelError: u.px } : {}), ...(u.chunks !== undefined ? { maxChunks: u.chunks } : {}) });
+      this.ui.setLod(this.selection.settings);
+      this.readiness.reset();
+    }
     if (fromUser) this.ui.setMode(this.cameras.mode, this.cameras.walk);
   }
 
@@ -455,12 +460,16 @@ export class App implements TestHookTarget {
   /** The URL hash of the view now: the planet, the mode and the camera. */
   private viewHash(): string {
     const s = this.cameras.state;
+    const lod = this.selection.settings;
     return formatHash({
       ...(this.choice.preset ? { preset: this.choice.preset } : {}),
       ...(this.choice.seed ? { seed: this.choice.seed } : {}),
       mode: this.cameras.mode,
       walk: this.cameras.walk,
       ...(Number.isFinite(s.alt) ? { lat: s.lat, lon: s.lon, alt: s.alt, heading: s.heading, pitch: s.pitch } : {}),
+      // the detail settings, where they are not the defaults
+      ...(lod.maxPixelError !== DEFAULT_LOD.maxPixelError ? { px: lod.maxPixelError } : {}),
+      ...(lod.maxChunks !== DEFAULT_LOD.maxChunks ? { chunks: lod.maxChunks } : {}),
     });
   }
 
@@ -663,6 +672,7 @@ export class App implements TestHookTarget {
     this.selection.setSettings(settings);
     this.ui.setLod(this.selection.settings);
     this.readiness.reset();
+    this.writeHash(true);
   }
 
   lodSettings(): LodSettings {

@@ -1,5 +1,6 @@
 // The viewer's state in the URL hash, e.g.
-// `#preset=earthlike&seed=7&mode=orbit&lat=12.5&lon=-40&alt=3000&heading=0&pitch=-90`.
+// `#preset=earthlike&seed=7&mode=orbit&lat=12.5&lon=-40&alt=3000&heading=0&pitch=-90`, and the
+// detail settings when they are not the defaults (`&px=1&chunks=4000`).
 // Pure: parse and format only.
 
 import type { CameraMode } from './cameraModel';
@@ -14,6 +15,9 @@ export interface UrlState {
   alt?: number;
   heading?: number;
   pitch?: number;
+  /** The detail settings: the largest screen-space error (pixels) and the chunk budget. */
+  px?: number;
+  chunks?: number;
 }
 
 const NUMBER_KEYS = ['lat', 'lon', 'alt', 'heading', 'pitch'] as const;
@@ -36,6 +40,10 @@ export function parseHash(hash: string): UrlState {
     if (Number.isFinite(n)) out[k] = n;
   }
   if (out.lat !== undefined) out.lat = Math.max(-90, Math.min(90, out.lat));
+  const px = Number(params.get('px') ?? NaN);
+  if (Number.isFinite(px) && px >= 0.1 && px <= 100) out.px = px;
+  const chunks = Number(params.get('chunks') ?? NaN);
+  if (Number.isInteger(chunks) && chunks >= 1 && chunks <= 1_000_000) out.chunks = chunks;
   return out;
 }
 
@@ -55,5 +63,7 @@ export function formatHash(s: UrlState): string {
   if (s.alt !== undefined) params.set('alt', fmt(s.alt, 1));
   if (s.heading !== undefined) params.set('heading', fmt(s.heading, 1));
   if (s.pitch !== undefined) params.set('pitch', fmt(s.pitch, 1));
+  if (s.px !== undefined) params.set('px', fmt(s.px, 2));
+  if (s.chunks !== undefined) params.set('chunks', String(Math.round(s.chunks)));
   return `#${params.toString()}`;
 }

@@ -18,3 +18,15 @@ describe('URL hash state', () => {
     expect(parseHash('lat=95').lat).toBe(90);
   });
 });
+
+describe('the detail settings in the URL', () => {
+  it('round-trip, and only sane values are read', () => {
+    const h = formatHash({ preset: 'earth', seed: '7', lat: 1, lon: 2, alt: 3, px: 1.5, chunks: 4000 });
+    expect(h).toContain('px=1.5');
+    expect(h).toContain('chunks=4000');
+    expect(parseHash(h)).toMatchObject({ px: 1.5, chunks: 4000 });
+    expect(parseHash('#px=0&chunks=1.5')).toEqual({});
+    expect(parseHash('#px=abc&chunks=-3')).toEqual({});
+    expect(parseHash('#px=1000&chunks=1e9')).toEqual({});
+  });
+});

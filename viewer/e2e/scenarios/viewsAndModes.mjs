@@ -118,6 +118,19 @@ export async function scenario(t) {
   const back = await ready('back at the bookmark');
   check(Math.abs(back.lat - (27 + 59 / 60)) < 1e-4 && Math.abs(back.lon - (86 + 55 / 60)) < 1e-4 && Math.abs(back.alt - 300) < 0.1, `the bookmark led to ${back.lat}, ${back.lon}, ${back.alt}`);
 
+  // the detail settings in the link: a pixel error of 1 survives a reload
+  await page.fill('#lod-px', '1');
+  await page.press('#lod-px', 'Enter');
+  await page.waitForFunction(() => location.hash.includes('px=1'), null, { timeout: 10_000 }).catch(() => undefined);
+  const linked = await page.evaluate(() => location.hash);
+  await page.reload({ waitUntil: 'load' });
+  await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+  const detail = await hook(() => window.__pmc.lod());
+  log(`  link with the detail settings: ${linked}`);
+  check(linked.includes('px=1') && detail.maxPixelError === 1 && (await page.inputValue('#lod-px')) === '1', `the pixel error did not survive the link: ${linked}, ${JSON.stringify(detail)}`);
+  await hook(() => window.__pmc.lod({ maxPixelError: 2 }));
+  await ready('back to the default detail');
+
   // the planet named in the panel and the title
   const shownName = [await page.textContent('#s-planet'), await page.title()];
   check(shownName[0] === 'earthlike · seed 7' && shownName[1] === 'earthlike · seed 7 — PMC', `the planet is named ${JSON.stringify(shownName)}`);
