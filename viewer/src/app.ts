@@ -133,6 +133,7 @@ export class App implements TestHookTarget {
       onLod: (settings) => this.setLod(settings),
       onSky: (settings) => void this.setSky(settings),
       onBookmarkAdd: () => this.addBookmark(),
+      onScreenshot: () => this.screenshot(),
       onBookmarkOpen: (name) => this.openBookmark(name),
       onBookmarkRemove: (name) => {
         this.bookmarks = withoutBookmark(this.bookmarks, name);
@@ -398,6 +399,22 @@ export class App implements TestHookTarget {
     this.flight = { plan: new Flight(from, to, this.params.shape.datum), start: performance.now() };
     this.readiness.reset();
     return target;
+  }
+
+  /**
+   * Saves the picture as a PNG (the canvas: the planet without the panels), named by the planet
+   * and the place: `pmc-earthlike-seed-7-27.983N-86.917E.png`.
+   */
+  screenshot(): string {
+    const s = this.cameras.state;
+    const slug = this.planetTitle.replace(/[^A-Za-z0-9.]+/g, '-').replace(/^-+|-+$/g, '');
+    const place = `${Math.abs(s.lat).toFixed(3)}${s.lat >= 0 ? 'N' : 'S'}-${Math.abs(s.lon).toFixed(3)}${s.lon >= 0 ? 'E' : 'W'}`;
+    const name = `pmc-${slug}-${place}.png`;
+    const a = document.createElement('a');
+    a.href = this.loop.snapshot();
+    a.download = name;
+    a.click();
+    return name;
   }
 
   /** Keeps the current view as a bookmark named by its place. */

@@ -83,6 +83,15 @@ export class FrameLoop {
   }
 
   /** Draws the scene, remembering the key of the picture drawn. */
+  /**
+   * The picture as a PNG data URL: drawn anew and read back at once (before the browser
+   * composites the frame and clears the drawing buffer). The canvas alone: no panel is in it.
+   */
+  snapshot(): string {
+    this.draw(performance.now());
+    return this.parts.renderer.domElement.toDataURL('image/png');
+  }
+
   private draw(now: number): void {
     const { renderer, scene, cameras } = this.parts;
     renderer.render(scene.scene, cameras.camera);

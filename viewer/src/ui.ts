@@ -25,6 +25,8 @@ export interface UiCallbacks {
   onBookmarkAdd(): void;
   onBookmarkOpen(name: string): void;
   onBookmarkRemove(name: string): void;
+  /** The screenshot button. */
+  onScreenshot(): void;
 }
 
 export interface StatsView {
@@ -111,6 +113,7 @@ export class Ui {
       if (marks.value !== '') this.callbacks.onBookmarkOpen(marks.value);
     });
     byId<HTMLButtonElement>('bookmark-add').addEventListener('click', () => this.callbacks.onBookmarkAdd());
+    byId<HTMLButtonElement>('screenshot').addEventListener('click', () => this.callbacks.onScreenshot());
     byId<HTMLButtonElement>('bookmark-remove').addEventListener('click', () => {
       if (marks.value !== '') this.callbacks.onBookmarkRemove(marks.value);
     });

@@ -1,7 +1,8 @@
 // Step 6: debug views, mode switch, walk mode, the URL hash, the keyboard help (?) and H.
 
+import { readFileSync } from 'node:fs';
 import { check, log } from '../harness.mjs';
-import { fractionDifferent } from '../images.mjs';
+import { decodePng, fractionDifferent } from '../images.mjs';
 
 export const name = '6. debug views, mode switch, walk mode, the URL hash, the keyboard help and hiding the panels';
 
@@ -130,6 +131,16 @@ export async function scenario(t) {
   check(linked.includes('px=1') && detail.maxPixelError === 1 && (await page.inputValue('#lod-px')) === '1', `the pixel error did not survive the link: ${linked}, ${JSON.stringify(detail)}`);
   await hook(() => window.__pmc.lod({ maxPixelError: 2 }));
   await ready('back to the default detail');
+
+  // the screenshot button: a PNG of the canvas alone, named by the planet and the place, the
+  // picture the page shows with its panels hidden
+  const [download] = await Promise.all([page.waitForEvent('download', { timeout: 30_000 }), page.click('#screenshot')]);
+  const png = decodePng(readFileSync(await download.path()));
+  const seen = await shot('screenshot-page');
+  const off = fractionDifferent(png, seen);
+  log(`  screenshot: ${download.suggestedFilename()}, ${png.width} x ${png.height}, ${(100 * off).toFixed(2)} % of the pixels unlike the page's picture`);
+  check(/^pmc-earthlike-seed-7-27\.983N-86\.917E\.png$/.test(download.suggestedFilename()), `the screenshot is named ${download.suggestedFilename()}`);
+  check(png.width === seen.width && png.height === seen.height && off < 0.01, `the screenshot (${png.width} x ${png.height}) is not the picture shown (${(100 * off).toFixed(1)} % unlike)`);
 
   // the planet named in the panel and the title
   const shownName = [await page.textContent('#s-planet'), await page.title()];
