@@ -390,6 +390,12 @@ export class App implements TestHookTarget {
   goTo(text: string): GoToTarget {
     const target = parseGoTo(text);
     if ('error' in target) throw new Error(target.error);
+    this.flyTo(target);
+    return target;
+  }
+
+  /** Flies to `target` (the altitude kept when it has none), as `goTo` does. */
+  private flyTo(target: GoToTarget): void {
     if (!this.params) throw new Error('no planet yet to go to a place on');
     // (walking would hold the camera to the ground on the way)
     if (this.cameras.walk) this.setWalk(false);
@@ -398,7 +404,6 @@ export class App implements TestHookTarget {
     const to = { lat: target.lat, lon: target.lon, alt: target.alt ?? from.alt };
     this.flight = { plan: new Flight(from, to, this.params.shape.datum), start: performance.now() };
     this.readiness.reset();
-    return target;
   }
 
   /**
@@ -433,7 +438,7 @@ export class App implements TestHookTarget {
     if (!b) return;
     const u = parseHash(b.hash);
     if (b.planet === this.planetTitle && u.lat !== undefined && u.lon !== undefined) {
-      this.goTo(`${u.lat}, ${u.lon}${u.alt !== undefined ? `, ${u.alt}` : ''}`);
+      this.flyTo({ lat: u.lat, lon: u.lon, alt: u.alt ?? null });
     } else {
       location.hash = b.hash;
     }
