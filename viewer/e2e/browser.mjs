@@ -92,7 +92,7 @@ export async function openBrowser() {
   const gridState = () => { const { components, onScreen: _o, visible: _v, ...rest } = window.__pmc.navgrid(); return { ...rest, components: components.length }; };
   /** A screenshot of the view of `p` alone (panels hidden), saved under e2e/artifacts. */
   const shotOf = async (p, name) => {
-    await p.addStyleTag({ content: '.panel, #loading, #error { visibility: hidden !important; }' }).then((h) => h.evaluate((el) => el.setAttribute('id', 'e2e-hide')));
+    await p.addStyleTag({ content: '.panel, #notices, #loading-bar { visibility: hidden !important; }' }).then((h) => h.evaluate((el) => el.setAttribute('id', 'e2e-hide')));
     // two more frames so the last chunks are on screen
     await hookOn(p)(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(() => r()))));
     const buf = await p.screenshot({ type: 'png', timeout: 60_000 });
@@ -101,6 +101,17 @@ export async function openBrowser() {
     return decodePng(buf);
   };
   const shot = (name) => shotOf(page, name);
+  /**
+   * Opens the side panel of `p` (as a click on ☰ does) with `sections` unfolded (their
+   * `data-section` names: stats, view, planet, detail, debug, sky).
+   */
+  const openPanelOf = async (p, sections = []) => {
+    if ((await p.getAttribute('#panel-toggle', 'aria-expanded')) !== 'true') await p.click('#panel-toggle');
+    for (const name of sections) {
+      if (!(await p.$eval(`#side details[data-section="${name}"]`, (d) => d.open))) await p.click(`#side details[data-section="${name}"] > summary`);
+    }
+  };
+  const openPanel = (sections) => openPanelOf(page, sections);
   /** The harness of the level-of-detail flights (e2e/lodFlight.mjs). */
   const flightHarness = {
     page,
@@ -129,6 +140,8 @@ export async function openBrowser() {
     gridState,
     shotOf,
     shot,
+    openPanelOf,
+    openPanel,
     flightHarness,
   };
 }

@@ -42,6 +42,7 @@ import * as levelSwitch from './scenarios/levelSwitch.mjs';
 import * as lodDefault from './scenarios/lodDefault.mjs';
 import * as lodEarth from './scenarios/lodEarth.mjs';
 import * as newChunks from './scenarios/newChunks.mjs';
+import * as overlays from './scenarios/overlays.mjs';
 import * as pageLoads from './scenarios/pageLoads.mjs';
 import * as pathAndNavGrid from './scenarios/pathAndNavGrid.mjs';
 import * as planetDrawn from './scenarios/planetDrawn.mjs';
@@ -60,7 +61,7 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
  */
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
 /** Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API). */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel, sky, imagery, levelSwitch, seaByData];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel, sky, imagery, levelSwitch, seaByData, overlays];
 
 async function main() {
   if (!existsSync(join(distDir, 'index.html'))) throw new Error('viewer/dist is missing: run `npm run build` first');

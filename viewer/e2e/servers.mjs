@@ -13,7 +13,7 @@ import { startMockServer } from './mockServer.mjs';
  * (a world file: editing on); reads the port from its "PMC viewer: URL" line. Returns its base URL
  * and a `stop()` (also run at the end).
  */
-export async function startPmcServe(layout, { world = null, extra = [] } = {}) {
+export async function startPmcServe(layout, { world = null, extra = [], port = 0 } = {}) {
   if (!existsSync(PMC_BIN)) {
     throw new Error(`no pmc binary at ${PMC_BIN}: build it (cargo build --release --bin pmc) or set PMC_BIN`);
   }
@@ -32,7 +32,7 @@ export async function startPmcServe(layout, { world = null, extra = [] } = {}) {
       );
     }
   }
-  const args = ['serve', '--port', '0'];
+  const args = ['serve', '--port', String(port)];
   if (layout) args.push('--n-c', String(layout.n_c), '--n-t', String(layout.n_t));
   if (world) args.push('--world', world);
   args.push(...extra);
@@ -139,13 +139,15 @@ export async function startBackend(layout, { world = null, extra = [] } = {}) {
   const fresh = readFileSync(join(distDir, 'index.html'), 'utf8');
   if (embedded.text === fresh || process.env.PMC_E2E_DIRECT === '1') {
     log(`testing the viewer embedded in pmc (${embedded.text === fresh ? 'same build as viewer/dist' : 'PMC_E2E_DIRECT=1'})`);
-    return { url: pmc.base, api: pmc.base, stop: pmc.stop };
+    return { url: pmc.base, api: pmc.base, stop: pmc.stop, stopApi: pmc.stop };
   }
   log('the viewer embedded in pmc differs from viewer/dist (rebuild pmc to embed it): serving viewer/dist in front of the real API');
   const front = await startFront(pmc.base);
   return {
     url: front.url,
     api: pmc.base,
+    /** Stops `pmc serve` alone (the front, if any, stays: a server gone behind a proxy). */
+    stopApi: pmc.stop,
     stop: async () => {
       await front.stop();
       await pmc.stop();

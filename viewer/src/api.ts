@@ -250,8 +250,16 @@ export function isAbort(e: unknown): boolean {
 
 export type FetchFn = (input: string, init?: RequestInit) => Promise<Response>;
 
+/** Told of each request's fate: answered (any HTTP status), or the server could not be reached. */
+export interface ReachObserver {
+  reached(): void;
+  unreachable(): void;
+}
+
 export class PmcApi {
   private readonly fetchFn: FetchFn;
+  /** Told whether requests reach the server (the connection monitor). */
+  observer: ReachObserver | null = null;
 
   constructor(
     /** Prefix of the API, e.g. `api/v1` (relative to the page) or `http://host:8080/api/v1`. */
@@ -277,8 +285,12 @@ export class PmcApi {
       res = await this.fetchFn(url, signal ? { ...init, signal } : init);
     } catch (e) {
       if (isAbort(e)) throw e;
+      this.observer?.unreachable();
       throw new ApiError(`cannot reach the PMC server (${String(e)})`, 0, url);
     }
+    // a proxy's 502 or 504: the PMC server behind it does not answer
+    if (res.status === 502 || res.status === 504) this.observer?.unreachable();
+    else this.observer?.reached();
     if (!res.ok) {
       let message = `${res.status} ${res.statusText}`.trim();
       let serverMessage: string | null = null;

@@ -9,6 +9,7 @@ import { atmosphereOf } from './atmosphereModel';
 import type { CameraMode } from './cameraModel';
 import { CameraController, type PickResult } from './cameraController';
 import { ChunkStreamer } from './chunkStreamer';
+import { ConnectionMonitor, offlineMessage } from './connection';
 import { formatLevels } from './chunkSelection';
 import { EditSession, type EditStatus } from './editSession';
 import { toolByName, type ToolName } from './editTools';
@@ -90,6 +91,11 @@ export class App implements TestHookTarget {
   private lastHashWrite = 0;
   private writtenHash = '';
   private error: string | null = null;
+  /** The `/planet` answer shown (to tell, back online, whether the server serves another planet). */
+  private planetJson = '';
+  /** Whether the server answers (the notice and the retry when it does not). */
+  readonly connection: ConnectionMonitor;
+  private offlineTicker: ReturnType<typeof setInterval> | null = null;
 
   constructor(private readonly canvas: HTMLCanvasElement) {
     // a logarithmic depth buffer: the same relative depth precision from 5 cm to the far side of
@@ -103,6 +109,12 @@ export class App implements TestHookTarget {
       stencil: true,
     });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+    this.connection = new ConnectionMonitor({
+      probe: () => this.api.health().then(() => undefined),
+      onChange: () => this.showConnection(),
+      onOnline: () => this.resume(),
+    });
+    this.api.observer = this.connection;
     this.renderer.outputColorSpace = THREE.SRGBColorSpace;
     this.cameras = new CameraController(canvas, () => this.scene.terrainMeshes());
 
@@ -134,6 +146,8 @@ export class App implements TestHookTarget {
       onSky: (settings) => void this.setSky(settings),
       onBookmarkAdd: () => this.addBookmark(),
       onScreenshot: () => this.screenshot(),
+      onNorth: () => this.faceNorth(),
+      onRetry: () => this.connection.retryNow(),
       onBookmarkOpen: (name) => this.openBookmark(name),
       onBookmarkRemove: (name) => {
         this.bookmarks = withoutBookmark(this.bookmarks, name);
@@ -311,6 +325,7 @@ export class App implements TestHookTarget {
   }
 
   private applyPlanet(info: PlanetInfo): void {
+    this.planetJson = JSON.stringify(info);
     this.params = planetParams(info);
     this.planetTitle = planetName(info);
     document.title = `${this.planetTitle} — PMC`;
@@ -404,6 +419,42 @@ export class App implements TestHookTarget {
     const to = { lat: target.lat, lon: target.lon, alt: target.alt ?? from.alt };
     this.flight = { plan: new Flight(from, to, this.params.shape.datum), start: performance.now() };
     this.readiness.reset();
+  }
+
+  /** Turns the camera to face north, where it is (the compass, `R`). */
+  faceNorth(): void {
+    this.cameras.state = { ...this.cameras.state, heading: 0 };
+    this.writeHash(true);
+  }
+
+  /** The server-gone notice, kept up to date each second while the server does not answer. */
+  private showConnection(): void {
+    const s = this.connection.state();
+    this.ui.setOffline(offlineMessage(s, Date.now()));
+    if (!s.online && this.offlineTicker === null) {
+      this.offlineTicker = setInterval(() => this.ui.setOffline(offlineMessage(this.connection.state(), Date.now())), 1000);
+    } else if (s.online && this.offlineTicker !== null) {
+      clearInterval(this.offlineTicker);
+      this.offlineTicker = null;
+    }
+  }
+
+  /**
+   * The server answers again: what failed meanwhile is fetched now, the edit stream reconnects
+   * (its `hello` tells what was missed), and a server that now serves another planet (restarted
+   * with other options) has it loaded.
+   */
+  private resume(): void {
+    this.streamer.retryFailed();
+    this.editor.reconnectNow();
+    if (this.params === null) return;
+    const choice = this.choice;
+    void this.api
+      .planet(choice)
+      .then((info) => {
+        if (choice === this.choice && JSON.stringify(info) !== this.planetJson) void this.loadPlanet(choice, true);
+      })
+      .catch(() => undefined);
   }
 
   /**
@@ -551,6 +602,15 @@ export class App implements TestHookTarget {
         return true;
       case 'help':
         if (!e.repeat) this.ui.toggleHelp();
+        return true;
+      case 'panel':
+        if (!e.repeat) this.ui.togglePanel();
+        return true;
+      case 'goto':
+        this.ui.focusGoTo();
+        return true;
+      case 'north':
+        if (!e.repeat) this.faceNorth();
         return true;
       default:
         // the camera's keys (input.ts)
@@ -792,6 +852,7 @@ export class App implements TestHookTarget {
       drawCalls: this.renderer.info.render.calls,
       ready: this.readiness.ready,
       error: this.error,
+      online: this.connection.state().online,
       loadedKeys: this.streamer.shownNames(),
       background: this.scene.backgroundRgb(),
       lod: {

@@ -12,7 +12,10 @@ import {
   maxAltitude,
   minOrbitAltitude,
   orbitDrag,
+  orbitTilt,
   orbitZoom,
+  pinchAsWheel,
+  ORBIT_MAX_PITCH,
   toFly,
   toOrbit,
   type CameraMode,
@@ -147,7 +150,8 @@ export class CameraController {
     if (u.alt !== undefined) s.alt = u.alt;
     if (u.heading !== undefined) s.heading = u.heading;
     if (u.pitch !== undefined) s.pitch = Math.max(-90, Math.min(90, u.pitch));
-    if (this.mode === 'orbit') s.pitch = -90;
+    // orbit keeps a tilt (a link to a tilted orbit view opens it tilted), at most ORBIT_MAX_PITCH
+    if (this.mode === 'orbit') s.pitch = u.pitch !== undefined ? Math.min(ORBIT_MAX_PITCH, s.pitch) : -90;
     this.clampAltitude(shape);
   }
 
@@ -216,11 +220,29 @@ export class CameraController {
         this.state = orbitDrag(this.state, shape, input.dragX, input.dragY, this.viewport().height, FOV);
         moved = true;
       }
-      if (input.wheel !== 0) {
-        this.state = orbitZoom(this.state, shape, input.wheel);
+      if (input.wheel !== 0 || input.pinch !== 0) {
+        this.state = orbitZoom(this.state, shape, input.wheel + pinchAsWheel(input.pinch));
+        moved = true;
+      }
+      if (input.tilt !== 0) {
+        this.state = orbitTilt(this.state, input.tilt);
         moved = true;
       }
     } else {
+      if (input.tilt !== 0) {
+        this.state = look(this.state, 0, input.tilt);
+        if (this.walk) this.state.pitch = Math.max(-80, Math.min(80, this.state.pitch));
+        moved = true;
+      }
+      if (input.pinch !== 0) {
+        // a pinch moves along the view: spreading the fingers twice as far goes ln 2 of the
+        // height over the ground forward
+        const r = length(cameraPosition(this.state, shape));
+        const height = this.aboveGround ?? Math.max(1, r - shape.outer);
+        const step = Math.max(-2, Math.min(2, input.pinch)) * Math.max(1, height);
+        this.state = flyMove(this.state, shape, { forward: Math.sign(step), right: 0, up: 0 }, 1, Math.abs(step), this.walk).state;
+        moved = true;
+      }
       if (input.dragX !== 0 || input.dragY !== 0) {
         this.state = look(this.state, input.dragX * 0.15, -input.dragY * 0.15);
         if (this.walk) this.state.pitch = Math.max(-80, Math.min(80, this.state.pitch));

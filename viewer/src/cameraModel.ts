@@ -2,7 +2,8 @@
 //
 // The camera is described by latitude, longitude, altitude (metres above the planet's datum: sea
 // level, or the middle of the shell without sea), heading (degrees clockwise from north) and pitch
-// (degrees above the horizon). ORBIT looks at the planet centre (pitch -90) and moves around it;
+// (degrees above the horizon). ORBIT looks down at the planet (pitch -90, or tilted up to
+// ORBIT_MAX_PITCH by a middle drag or two fingers) and moves around it;
 // FLY moves freely with the local radial direction as "up"; WALK is FLY glued a few metres above
 // the ground.
 
@@ -44,6 +45,14 @@ export interface PlanetShape {
 }
 
 export const MAX_PITCH = 89.5;
+
+/** Orbit's tilt: the highest pitch it looks at (30° under the horizontal); -90 looks straight down. */
+export const ORBIT_MAX_PITCH = -30;
+
+/** Orbit: tilted by `deg` (positive: toward the horizon), between straight down and ORBIT_MAX_PITCH. */
+export function orbitTilt(s: CameraState, deg: number): CameraState {
+  return { ...s, pitch: Math.max(-90, Math.min(ORBIT_MAX_PITCH, s.pitch + deg)) };
+}
 
 /** Planet-frame position of a camera state. */
 export function cameraPosition(s: CameraState, shape: PlanetShape): V3 {
@@ -115,14 +124,23 @@ export function orbitDrag(
   const { lat, lon } = latLonFromPosition(np);
   const enu = enuAt(np);
   const heading = wrapHeading((Math.atan2(dot(nUp, enu.east), dot(nUp, enu.north)) * 180) / Math.PI);
-  return { lat, lon, alt: s.alt, heading, pitch: -90 };
+  // the tilt stays (the drag moves the ground along the heading, as if seen from straight above)
+  return { lat, lon, alt: s.alt, heading, pitch: Math.max(-90, Math.min(ORBIT_MAX_PITCH, s.pitch)) };
 }
+
+/** The wheel delta (pixels) that zooms as a pinch of `pinch` (the log of the fingers' distance ratio) does. */
+export function pinchAsWheel(pinch: number): number {
+  return -pinch / WHEEL_ZOOM;
+}
+
+/** Zoom per wheel pixel: the height over the terrain is multiplied by exp(delta * WHEEL_ZOOM). */
+const WHEEL_ZOOM = 0.0015;
 
 /** Orbit: zoom by a wheel delta (pixels; positive zooms out), multiplicative in height above the terrain. */
 export function orbitZoom(s: CameraState, shape: PlanetShape, wheelDelta: number): CameraState {
   const base = shape.outer - shape.datum; // altitude of the highest terrain
   const above = Math.max(1e-3, s.alt - base);
-  const factor = Math.exp(Math.max(-2, Math.min(2, wheelDelta * 0.0015)));
+  const factor = Math.exp(Math.max(-2, Math.min(2, wheelDelta * WHEEL_ZOOM)));
   const alt = Math.min(maxAltitude(shape), Math.max(minOrbitAltitude(shape), base + above * factor));
   return { ...s, alt };
 }

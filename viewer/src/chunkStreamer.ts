@@ -167,6 +167,12 @@ export class ChunkStreamer {
     this.now = opts.now ?? (() => performance.now());
   }
 
+  /** Forgets the failures' back-off and requests what is missing now (the server is back). */
+  retryFailed(): void {
+    this.failures.clear();
+    this.pump();
+  }
+
   /** Drops every chunk and request, and streams `planet` (with its level-of-detail data) from now on. */
   setPlanet(planet: PlanetChoice, lod: LodPlanet | null): void {
     this.generation++;
@@ -488,7 +494,9 @@ export class ChunkStreamer {
         this.counts.failed++;
         const count = (this.failures.get(id)?.count ?? 0) + 1;
         this.failures.set(id, { count, retryAt: this.now() + retryDelay(e, count) });
-        // a busy server is normal under load: report only what keeps failing
+        // a busy server is normal under load: report only what keeps failing; a server that
+        // cannot be reached is the connection notice's (connection.ts), not one chunk's
+        if (e instanceof ApiError && (e.status === 0 || e.status === 502 || e.status === 504)) return;
         if (!(e instanceof ApiError && e.transient && count < 3)) {
           this.reportError(`chunk ${name}: ${errorMessage(e)}`);
         }

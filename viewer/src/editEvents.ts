@@ -165,6 +165,14 @@ export class EditFeed {
     this.connect();
   }
 
+  /** Reconnects now when waiting to (the server is back), instead of after the back-off. */
+  reconnectNow(): void {
+    if (this.timer === null) return;
+    this.clearTimer(this.timer);
+    this.failures = 0;
+    this.connect();
+  }
+
   /** Disconnects and stops reconnecting. */
   close(): void {
     if (this.timer !== null) this.clearTimer(this.timer);

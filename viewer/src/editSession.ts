@@ -183,6 +183,11 @@ export class EditSession {
     this.onChange();
   }
 
+  /** The server is back: the edit stream reconnects now (its `hello` tells what was missed). */
+  reconnectNow(): void {
+    this.feed?.reconnectNow();
+  }
+
   get enabled(): boolean {
     return this.info !== null;
   }

@@ -4,7 +4,8 @@
 // settled frames `__pmc.ready()` waits for and refreshes the panels.
 
 import * as THREE from 'three';
-import type { CameraController } from './cameraController';
+import { FOV, type CameraController } from './cameraController';
+import { metresPerPixel, rayToSphere, scaleBar } from './hud';
 import { formatLevels } from './chunkSelection';
 import type { ChunkStreamer } from './chunkStreamer';
 import { length, type V3 } from './frames';
@@ -134,7 +135,7 @@ export class FrameLoop {
     const input = inputs.take();
     if (!params) {
       if (this.pictureKey.changed(this.frameKey([0, 0, 0]))) this.draw(now);
-      ui.setLoading(0, 0, steps.busy() ?? 'waiting for the server');
+      ui.setLoading(0, 0, 0, steps.busy() ?? 'waiting for the server');
       steps.panels(false);
       return;
     }
@@ -172,6 +173,11 @@ export class FrameLoop {
     if (now - this.lastUiUpdate > 200) {
       this.lastUiUpdate = now;
       const s = cameras.state;
+      // the scale bar: the ground's scale where the view's axis meets the sphere of the ground
+      // under the camera (of the datum where that is not known yet)
+      const groundR = cameras.aboveGround !== null ? r - cameras.aboveGround : shape.datum;
+      const hit = rayToSphere(pos, basis.forward, groundR);
+      const scale = hit === null ? null : scaleBar(metresPerPixel(hit, FOV, renderer.domElement.clientHeight));
       ui.setStats({
         planet: steps.planetLabel(),
         chunks: st.shown,
@@ -185,8 +191,9 @@ export class FrameLoop {
         alt: s.alt,
         aboveGround: cameras.aboveGround,
         heading: s.heading,
+        scale,
       });
-      ui.setLoading(st.pending, st.missing, steps.busy());
+      ui.setLoading(st.shown, st.pending, st.missing, steps.busy());
       steps.editStats();
     }
     steps.panels(true);
@@ -200,6 +207,8 @@ function inputActive(input: InputFrame): boolean {
     input.dragX !== 0 ||
     input.dragY !== 0 ||
     input.wheel !== 0 ||
+    input.tilt !== 0 ||
+    input.pinch !== 0 ||
     input.forward !== 0 ||
     input.right !== 0 ||
     input.up !== 0 ||

@@ -1,4 +1,6 @@
-// Mouse, wheel and keyboard input on the canvas, turned into deltas the app consumes each frame.
+// Mouse, wheel, touch and keyboard input on the canvas, turned into deltas the app consumes each
+// frame. Touch: one finger drags as the mouse does, two fingers pinch (zoom) or move up and down
+// together (tilt); the middle button's drag tilts too.
 
 import { SHORTCUTS, heldCodes, shortcutOf } from './shortcuts';
 
@@ -8,6 +10,10 @@ export interface InputFrame {
   dragY: number;
   /** Wheel delta since the last frame (pixels, positive = away / zoom out). */
   wheel: number;
+  /** Tilt since the last frame, degrees (positive: toward the horizon): middle drag, two fingers. */
+  tilt: number;
+  /** Pinch since the last frame: the log of the fingers' distance ratio (positive: spread, zoom in). */
+  pinch: number;
   forward: number;
   right: number;
   up: number;
@@ -33,6 +39,9 @@ export const BOUND_KEYS: ReadonlySet<string> = new Set(
   SHORTCUTS.filter((s) => s.held || s.action === 'mode' || s.action === 'walk').flatMap((s) => s.codes),
 );
 
+/** Degrees of tilt per pixel of a middle drag (or of two fingers' midpoint). */
+export const TILT_PER_PX = 0.25;
+
 export interface InputCallbacks {
   /** Tab: switch between orbit and fly. */
   onToggleMode(): void;
@@ -52,7 +61,12 @@ export class Input {
   private dragX = 0;
   private dragY = 0;
   private wheel = 0;
+  private tilt = 0;
+  private pinch = 0;
   private dragging = false;
+  private tilting = false;
+  /** The touches on the canvas (pointer id to its last position, client pixels). */
+  private readonly touches = new Map<number, { x: number; y: number }>();
   private lastX = 0;
   private lastY = 0;
   private brushing = false;
@@ -76,6 +90,28 @@ export class Input {
       this.disposers.push(() => target.removeEventListener(type, fn as EventListener, opts));
     };
     on(element, 'pointerdown', (e) => {
+      if (e.pointerType === 'touch') {
+        this.touches.set(e.pointerId, { x: e.clientX, y: e.clientY });
+        if (this.touches.size >= 2) {
+          // a second finger: a pinch or a tilt, not a drag nor an edit
+          this.dragging = false;
+          if (this.brushing) {
+            this.brushing = false;
+            this.brushPresses = [];
+            this.brushRelease = true;
+          }
+          element.setPointerCapture?.(e.pointerId);
+          return;
+        }
+      }
+      if (e.button === 1) {
+        e.preventDefault();
+        this.tilting = true;
+        this.lastY = e.clientY;
+        element.setPointerCapture?.(e.pointerId);
+        element.focus();
+        return;
+      }
       if (e.button !== 0 && e.button !== 2) return;
       this.hover = this.local(e);
       if (e.button === 0 && this.callbacks.brushActive?.()) {
@@ -96,7 +132,17 @@ export class Input {
         this.dragY += e.movementY;
         return;
       }
+      if (e.pointerType === 'touch' && this.touches.has(e.pointerId) && this.touches.size >= 2) {
+        this.twoFingers(e.pointerId, e.clientX, e.clientY);
+        return;
+      }
+      if (e.pointerType === 'touch' && this.touches.has(e.pointerId)) this.touches.set(e.pointerId, { x: e.clientX, y: e.clientY });
       this.hover = this.local(e);
+      if (this.tilting) {
+        this.tilt -= (e.clientY - this.lastY) * TILT_PER_PX;
+        this.lastY = e.clientY;
+        return;
+      }
       if (!this.dragging) return;
       this.dragX += e.clientX - this.lastX;
       this.dragY += e.clientY - this.lastY;
@@ -104,12 +150,24 @@ export class Input {
       this.lastY = e.clientY;
     });
     const stop = (e: PointerEvent): void => {
+      if (e.pointerType === 'touch' && this.touches.delete(e.pointerId)) {
+        if (this.touches.size === 1) {
+          // back to one finger: it drags on from where it is (no jump)
+          const [rest] = [...this.touches.values()];
+          this.dragging = !this.callbacks.brushActive?.();
+          this.lastX = rest!.x;
+          this.lastY = rest!.y;
+          return;
+        }
+        if (this.touches.size > 1) return;
+      }
+      if (e.button === 1 || e.type === 'pointercancel') this.tilting = false;
       if (this.brushing && (e.button === 0 || e.type === 'pointercancel')) {
         this.brushing = false;
         this.brushRelease = true;
       }
       if (e.button === 0 || e.button === 2 || e.type === 'pointercancel') this.dragging = false;
-      if (!this.brushing && !this.dragging && element.hasPointerCapture?.(e.pointerId)) {
+      if (!this.brushing && !this.dragging && !this.tilting && element.hasPointerCapture?.(e.pointerId)) {
         element.releasePointerCapture(e.pointerId);
       }
     };
@@ -129,6 +187,10 @@ export class Input {
       { passive: false },
     );
     on(element, 'contextmenu', (e) => e.preventDefault());
+    // the middle button tilts: no autoscroll, no paste
+    on(element, 'mousedown', (e) => {
+      if (e.button === 1) e.preventDefault();
+    });
     on(window, 'keydown', (e) => {
       if (isTyping(e.target)) return;
       if (this.callbacks.onShortcut?.(e)) {
@@ -156,11 +218,33 @@ export class Input {
     on(window, 'blur', () => {
       this.held.clear();
       this.dragging = false;
+      this.tilting = false;
+      this.touches.clear();
       if (this.brushing) {
         this.brushing = false;
         this.brushRelease = true;
       }
     });
+  }
+
+  /**
+   * Finger `id` of two or more moved to (`x`, `y`): against the first other finger, a pinch when
+   * their distance changed more than their midpoint rose or fell, else a tilt by the midpoint's
+   * vertical motion.
+   */
+  private twoFingers(id: number, x: number, y: number): void {
+    const before = this.touches.get(id)!;
+    const other = [...this.touches.entries()].find(([k]) => k !== id)?.[1];
+    this.touches.set(id, { x, y });
+    if (!other) return;
+    const d0 = Math.hypot(before.x - other.x, before.y - other.y);
+    const d1 = Math.hypot(x - other.x, y - other.y);
+    const rise = (y - before.y) / 2;
+    if (Math.abs(d1 - d0) > Math.abs(rise)) {
+      if (d0 > 1 && d1 > 1) this.pinch += Math.log(d1 / d0);
+    } else {
+      this.tilt -= rise * TILT_PER_PX;
+    }
   }
 
   private local(e: PointerEvent): { x: number; y: number } {
@@ -216,6 +300,8 @@ export class Input {
       dragX: this.dragX,
       dragY: this.dragY,
       wheel: this.wheel,
+      tilt: this.tilt,
+      pinch: this.pinch,
       forward: axis(FORWARD, BACK),
       right: axis(RIGHT, LEFT),
       up: axis(UP, DOWN),
@@ -229,6 +315,8 @@ export class Input {
     this.dragX = 0;
     this.dragY = 0;
     this.wheel = 0;
+    this.tilt = 0;
+    this.pinch = 0;
     return frame;
   }
 

@@ -24,6 +24,9 @@ export type ShortcutAction =
   | 'redo'
   | 'navgrid'
   | 'overlays'
+  | 'panel'
+  | 'goto'
+  | 'north'
   | 'help';
 
 /** The help's sections, in order. */
@@ -81,6 +84,9 @@ export const SHORTCUTS: readonly Shortcut[] = [
   { action: 'redo', codes: ['KeyY'], ctrl: true, shift: false, keys: 'Ctrl+Y', what: 'redo', group: 'Edits' },
   { action: 'navgrid', codes: ['KeyN'], shift: false, keys: 'N', what: 'the navigation grid around the camera on / off', group: 'View' },
   { action: 'overlays', codes: ['KeyH'], shift: false, keys: 'H', what: 'hide / show every overlay (the planet alone)', group: 'View' },
+  { action: 'panel', codes: ['KeyP'], shift: false, keys: 'P', what: 'open / close the side panel (statistics, planet, detail, debug, sky)', group: 'View' },
+  { action: 'goto', codes: [], char: '/', keys: '/', what: 'type a place in the go-to box', group: 'View' },
+  { action: 'north', codes: ['KeyR'], shift: false, keys: 'R', what: 'face north (as clicking the compass does)', group: 'Camera' },
   { action: 'help', codes: [], char: '?', keys: '?', what: 'this help', group: 'View' },
 ];
 
@@ -90,6 +96,10 @@ export const MOUSE_HELP: readonly { keys: string; what: string }[] = [
   { keys: 'wheel', what: 'orbit: zoom; fly: speed' },
   { keys: 'right drag', what: 'move the camera while a brush tool is chosen' },
   { keys: 'click', what: 'with a tool: edit, or set the ends of a path' },
+  { keys: 'middle drag', what: 'tilt: orbit from straight down to 30° under the horizontal; fly: look up and down' },
+  { keys: 'one finger', what: 'as a drag: turn the planet, or look around (with a tool: a tap edits)' },
+  { keys: 'pinch', what: 'orbit: zoom; fly: move forward and back' },
+  { keys: 'two fingers', what: 'drag up and down: tilt' },
 ];
 
 /** What a key event's shortcut fields are (a `KeyboardEvent` has them all). */

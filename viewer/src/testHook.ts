@@ -63,6 +63,8 @@ export interface PmcStats {
   drawCalls: number;
   ready: boolean;
   error: string | null;
+  /** Whether the server answers (false: the server-gone notice shows). */
+  online: boolean;
   /** The chunks shown (`face/level/i/j/k`). */
   loadedKeys: string[];
   /** The background colour drawn now (8-bit sRGB): what shows where nothing is drawn. */

@@ -120,6 +120,8 @@ export class ToolsUi {
   update(s: EditStatus, pathActive = false): void {
     const off = !s.enabled;
     this.panel.classList.toggle('disabled', off);
+    // a brush's settings open above the tool bar while a brush is chosen
+    this.panel.classList.toggle('brushing', !off && s.tool !== 'look' && !pathActive);
     const why = off ? `editing is off: ${s.reason ?? ''}` : '';
     this.pathButton.classList.toggle('active', pathActive);
     this.pathButton.setAttribute('aria-pressed', String(pathActive));
@@ -184,7 +186,8 @@ export class ToolsUi {
     }
     this.statusLine.textContent = text;
     this.statusLine.dataset['kind'] = kind;
-    this.statusLine.hidden = text === '';
+    // why editing is off stays in the buttons' tooltips (the line would cover the planet)
+    this.statusLine.hidden = text === '' || off;
   }
 
   /**

@@ -1,5 +1,7 @@
-// The DOM panels of index.html: stats, planet picker, mode switch, debug toggles, loading
-// indicator and error banner. Plain DOM, no framework.
+// The DOM overlays of index.html: the slim HUD (place, height, compass, scale bar), the go-to
+// box, the side panel (statistics, view, planet, detail, debug, sky; folded away by default, its
+// state remembered), the loading bar and notices, the error banner and the server-gone notice.
+// Plain DOM, no framework.
 
 import type { SkySettings, SkyState } from './atmosphere';
 import type { CameraMode } from './cameraModel';
@@ -7,6 +9,8 @@ import type { PresetInfo } from './api';
 import type { DebugFlags } from './planetScene';
 import type { NavGridStatus } from './navOverlay';
 import { MOUSE_HELP, SHORTCUTS, SHORTCUT_GROUPS } from './shortcuts';
+import { formatLat, formatLon, loadingShare, type ScaleBar } from './hud';
+import { PANEL_SECTIONS, loadPanelState, savePanelState, type PanelSection, type PanelState, type StorageLike } from './panelState';
 
 export interface UiCallbacks {
   onPlanet(preset: string, seed: string): void;
@@ -27,6 +31,10 @@ export interface UiCallbacks {
   onBookmarkRemove(name: string): void;
   /** The screenshot button. */
   onScreenshot(): void;
+  /** The compass: face north. */
+  onNorth(): void;
+  /** The server-gone notice's retry button. */
+  onRetry(): void;
 }
 
 export interface StatsView {
@@ -44,6 +52,8 @@ export interface StatsView {
   alt: number;
   aboveGround: number | null;
   heading: number;
+  /** The scale bar at the centre of the view; null where the view's centre is sky. */
+  scale: ScaleBar | null;
 }
 
 function byId<T extends HTMLElement>(id: string): T {
@@ -83,6 +93,32 @@ export class Ui {
   private readonly navgridStatus = byId<HTMLParagraphElement>('navgrid-status');
   private shownNavGrid = '';
   private readonly loading = byId<HTMLDivElement>('loading');
+  private readonly loadingBar = byId<HTMLDivElement>('loading-bar');
+  private readonly loadingBarFill = byId<HTMLDivElement>('loading-bar-fill');
+  private readonly offline = byId<HTMLDivElement>('offline');
+  private readonly offlineText = byId<HTMLSpanElement>('offline-text');
+  private readonly side = byId<HTMLElement>('side');
+  private readonly panelToggle = byId<HTMLButtonElement>('panel-toggle');
+  private readonly storage: StorageLike | null = (() => {
+    try {
+      return globalThis.localStorage ?? null;
+    } catch {
+      return null;
+    }
+  })();
+  private panel: PanelState = loadPanelState(this.storage);
+  private readonly hud = {
+    planet: byId('hud-planet'),
+    lat: byId('hud-lat'),
+    lon: byId('hud-lon'),
+    alt: byId('hud-alt'),
+    ground: byId('hud-ground'),
+    heading: byId('hud-heading'),
+    needle: document.getElementById('compass-needle') as Element | null,
+    scale: byId('scale'),
+    scaleBar: byId('scale-bar'),
+    scaleText: byId('scale-text'),
+  };
   private readonly loadingText = byId<HTMLSpanElement>('loading-text');
   private readonly error = byId<HTMLDivElement>('error');
   private readonly errorText = byId<HTMLSpanElement>('error-text');
@@ -108,6 +144,24 @@ export class Ui {
 
   constructor(private readonly callbacks: UiCallbacks) {
     this.renderKeysHelp();
+    this.applyPanel();
+    this.panelToggle.addEventListener('click', () => {
+      this.togglePanel();
+      this.panelToggle.blur();
+    });
+    for (const d of this.side.querySelectorAll<HTMLDetailsElement>('details[data-section]')) {
+      d.addEventListener('toggle', () => {
+        const name = d.dataset['section'] as PanelSection;
+        if (!PANEL_SECTIONS.includes(name) || this.panel.sections[name] === d.open) return;
+        this.panel.sections[name] = d.open;
+        savePanelState(this.storage, this.panel);
+      });
+    }
+    byId<HTMLButtonElement>('compass').addEventListener('click', (e) => {
+      this.callbacks.onNorth();
+      (e.currentTarget as HTMLElement).blur();
+    });
+    byId<HTMLButtonElement>('offline-retry').addEventListener('click', () => this.callbacks.onRetry());
     const marks = byId<HTMLSelectElement>('bookmarks');
     marks.addEventListener('change', () => {
       if (marks.value !== '') this.callbacks.onBookmarkOpen(marks.value);
@@ -279,13 +333,56 @@ export class Ui {
     this.fields.path.textContent = text;
   }
 
-  setLoading(pending: number, missing: number, busyText: string | null): void {
-    const show = busyText !== null || pending > 0;
-    this.loading.hidden = !show;
-    if (show) {
-      this.loadingText.textContent =
-        busyText ?? `loading ${pending + missing} chunk${pending + missing === 1 ? '' : 's'}`;
+  /**
+   * The loading bar (chunks shown among those wanted, while any are loading or missing) and the
+   * notice of what the viewer waits for (`busyText`: the planet, the server).
+   */
+  setLoading(shown: number, pending: number, missing: number, busyText: string | null): void {
+    this.loading.hidden = busyText === null;
+    if (busyText !== null) this.loadingText.textContent = busyText;
+    const share = busyText === null ? loadingShare(shown, pending, missing) : null;
+    this.loadingBar.hidden = share === null;
+    if (share !== null) {
+      const left = pending + missing;
+      this.loadingBarFill.style.width = `${(100 * share).toFixed(1)}%`;
+      this.loadingBar.setAttribute('aria-valuenow', (100 * share).toFixed(0));
+      this.loadingBar.title = `loading ${left} chunk${left === 1 ? '' : 's'}`;
     }
+  }
+
+  /** The server-gone notice: shown with `message`, or hidden (null). */
+  setOffline(message: string | null): void {
+    this.offline.hidden = message === null;
+    if (message !== null && this.offlineText.textContent !== message) this.offlineText.textContent = message;
+  }
+
+  /** Whether the side panel shows. */
+  get panelOpen(): boolean {
+    return this.panel.open;
+  }
+
+  /** Opens the side panel, or closes it; toggles when `open` is not given. Remembered. */
+  togglePanel(open?: boolean): boolean {
+    this.panel.open = open ?? !this.panel.open;
+    savePanelState(this.storage, this.panel);
+    this.applyPanel();
+    return this.panel.open;
+  }
+
+  private applyPanel(): void {
+    this.side.hidden = !this.panel.open;
+    this.panelToggle.setAttribute('aria-expanded', String(this.panel.open));
+    for (const d of this.side.querySelectorAll<HTMLDetailsElement>('details[data-section]')) {
+      const name = d.dataset['section'] as PanelSection;
+      if (PANEL_SECTIONS.includes(name)) d.open = this.panel.sections[name];
+    }
+  }
+
+  /** Puts the caret in the go-to box (`/`). */
+  focusGoTo(): void {
+    const input = byId<HTMLInputElement>('goto');
+    input.focus();
+    input.select();
   }
 
   /** The bookmarks' list (names, with their planets), `chosen` selected. */
@@ -293,7 +390,7 @@ export class Ui {
     const marks = byId<HTMLSelectElement>('bookmarks');
     const first = document.createElement('option');
     first.value = '';
-    first.textContent = list.length === 0 ? 'no bookmarks yet: ☆ keeps this view' : `bookmarks (${list.length})…`;
+    first.textContent = list.length === 0 ? 'no bookmarks: ☆ keeps one' : `bookmarks (${list.length})…`;
     const options = list.map((b) => {
       const o = document.createElement('option');
       o.value = b.name;
@@ -340,7 +437,7 @@ export class Ui {
       body.append(h, table);
     };
     for (const g of SHORTCUT_GROUPS) section(g, SHORTCUTS.filter((s) => s.group === g));
-    section('Mouse', MOUSE_HELP);
+    section('Mouse and touch', MOUSE_HELP);
   }
 
   showError(message: string): void {
@@ -377,10 +474,23 @@ export class Ui {
     f.levels.textContent = s.levels;
     f.triangles.textContent = fmtInt(s.triangles);
     f.fps.textContent = s.fps.toFixed(0);
-    f.lat.textContent = `${Math.abs(s.lat).toFixed(4)}° ${s.lat >= 0 ? 'N' : 'S'}`;
-    f.lon.textContent = `${Math.abs(s.lon).toFixed(4)}° ${s.lon >= 0 ? 'E' : 'W'}`;
+    f.lat.textContent = formatLat(s.lat);
+    f.lon.textContent = formatLon(s.lon);
     f.alt.textContent = formatDistance(s.alt);
     f.ground.textContent = s.aboveGround === null ? '–' : formatDistance(s.aboveGround);
     f.heading.textContent = `${s.heading.toFixed(0)}°`;
+    const h = this.hud;
+    h.planet.textContent = s.planet;
+    h.lat.textContent = formatLat(s.lat);
+    h.lon.textContent = formatLon(s.lon);
+    h.alt.textContent = `alt ${formatDistance(s.alt)}`;
+    h.ground.textContent = s.aboveGround === null ? '' : `· ${formatDistance(s.aboveGround)} over ground`;
+    h.heading.textContent = `heading ${s.heading.toFixed(0)}°`;
+    h.needle?.setAttribute('transform', `rotate(${(-s.heading).toFixed(1)})`);
+    h.scale.classList.toggle('none', s.scale === null);
+    if (s.scale !== null) {
+      h.scaleBar.style.width = `${s.scale.px.toFixed(1)}px`;
+      h.scaleText.textContent = s.scale.label;
+    }
   }
 }

@@ -5,7 +5,10 @@ import {
   look,
   minOrbitAltitude,
   orbitDrag,
+  orbitTilt,
   orbitZoom,
+  pinchAsWheel,
+  ORBIT_MAX_PITCH,
   toFly,
   toOrbit,
   type PlanetShape,
@@ -44,6 +47,28 @@ describe('orbit', () => {
     for (let n = 0; n < 100; n++) z = orbitZoom(z, shape, -500);
     expect(z.alt).toBe(minOrbitAltitude(shape));
     expect(shape.datum + z.alt).toBeGreaterThan(shape.outer);
+  });
+
+  it('tilts between straight down and 30° under the horizontal, and a drag keeps the tilt', () => {
+    const s = { lat: 0, lon: 0, alt: 2000, heading: 0, pitch: -90 };
+    expect(orbitTilt(s, 20).pitch).toBe(-70);
+    expect(orbitTilt(s, 200).pitch).toBe(ORBIT_MAX_PITCH);
+    expect(orbitTilt(orbitTilt(s, 30), -100).pitch).toBe(-90);
+    const tilted = orbitTilt(s, 40);
+    const moved = orbitDrag(tilted, shape, 0, 100, 600, 50);
+    expect(moved.pitch).toBe(-50);
+    // the drag moves the ground as seen from above: the same place as without the tilt
+    const flat = orbitDrag(s, shape, 0, 100, 600, 50);
+    expect([moved.lat, moved.lon, moved.heading]).toEqual([flat.lat, flat.lon, flat.heading]);
+  });
+
+  it('zooms with a pinch as the wheel does: spreading the fingers comes closer', () => {
+    const s = { lat: 0, lon: 0, alt: 3000, heading: 0, pitch: -90 };
+    const base = shape.outer - shape.datum;
+    const closer = orbitZoom(s, shape, pinchAsWheel(Math.log(2)));
+    // twice as far apart: half the height over the highest terrain
+    expect(closer.alt - base).toBeCloseTo((s.alt - base) / 2, 9);
+    expect(orbitZoom(s, shape, pinchAsWheel(-Math.log(2))).alt - base).toBeCloseTo(2 * (s.alt - base), 9);
   });
 
   it('switching modes keeps the place', () => {

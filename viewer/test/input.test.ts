@@ -1,5 +1,6 @@
 // Input with the DOM stubbed by EventTargets (vitest runs in node): the mouse buttons with and
-// without a brush tool, the editing shortcuts, and Shift inside a Ctrl chord.
+// without a brush tool, the editing shortcuts, Shift inside a Ctrl chord, the middle button's
+// tilt and the touch gestures (one finger drags, a pinch zooms, two fingers together tilt).
 
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { Input } from '../src/input';
@@ -41,6 +42,8 @@ class FakeCanvas extends EventTarget {
 
 const pointer = (type: string, button: number, x: number, y: number): Event =>
   Object.assign(new Event(type), { button, clientX: x, clientY: y, pointerId: 1, movementX: 0, movementY: 0 });
+const touch = (type: string, id: number, x: number, y: number): Event =>
+  Object.assign(new Event(type), { button: type === 'pointermove' ? -1 : 0, clientX: x, clientY: y, pointerId: id, pointerType: 'touch', movementX: 0, movementY: 0 });
 const key = (type: string, code: string, mods: Partial<KeyboardEvent> = {}): Event =>
   Object.assign(new Event(type, { cancelable: true }), { code, repeat: false, ctrlKey: false, shiftKey: false, metaKey: false, altKey: false, ...mods });
 
@@ -134,6 +137,62 @@ describe('Input', () => {
     f = input.take();
     expect(shortcuts).toEqual(['redo', 'walk']);
     expect(f.forward).toBe(1);
+    input.dispose();
+  });
+
+  it('tilts with the middle button: up toward the horizon, without dragging', () => {
+    const { canvas, input } = setup({ active: false });
+    canvas.dispatchEvent(pointer('pointerdown', 1, 100, 300));
+    canvas.dispatchEvent(pointer('pointermove', -1, 140, 260));
+    canvas.dispatchEvent(pointer('pointerup', 1, 140, 260));
+    const f = input.take();
+    expect([f.dragX, f.dragY, f.tilt, f.pinch]).toEqual([0, 0, 10, 0]);
+    input.dispose();
+  });
+
+  it('touch: one finger drags; spreading two pinches; two moving up together tilt; lifting one drags on without a jump', () => {
+    const { canvas, input } = setup({ active: false });
+    canvas.dispatchEvent(touch('pointerdown', 7, 100, 400));
+    canvas.dispatchEvent(touch('pointermove', 7, 120, 380));
+    let f = input.take();
+    expect([f.dragX, f.dragY, f.tilt, f.pinch]).toEqual([20, -20, 0, 0]);
+    // a second finger 100 px to the right; spread to 200 px apart
+    canvas.dispatchEvent(touch('pointerdown', 8, 220, 380));
+    canvas.dispatchEvent(touch('pointermove', 7, 70, 380));
+    canvas.dispatchEvent(touch('pointermove', 8, 270, 380));
+    f = input.take();
+    expect([f.dragX, f.dragY, f.tilt]).toEqual([0, 0, 0]);
+    expect(f.pinch).toBeCloseTo(Math.log(200 / 100), 12);
+    // both fingers 40 px up: a tilt of 40 px of the midpoint toward the horizon
+    canvas.dispatchEvent(touch('pointermove', 7, 70, 340));
+    canvas.dispatchEvent(touch('pointermove', 8, 270, 340));
+    f = input.take();
+    expect([f.dragX, f.dragY]).toEqual([0, 0]);
+    expect(f.tilt).toBeCloseTo(40 * 0.25, 12);
+    expect(Math.abs(f.pinch)).toBeLessThan(0.02);
+    // one finger lifted: the other drags on from where it is
+    canvas.dispatchEvent(touch('pointerup', 8, 270, 340));
+    canvas.dispatchEvent(touch('pointermove', 7, 80, 350));
+    f = input.take();
+    expect([f.dragX, f.dragY, f.tilt, f.pinch]).toEqual([10, 10, 0, 0]);
+    canvas.dispatchEvent(touch('pointerup', 7, 80, 350));
+    canvas.dispatchEvent(touch('pointermove', 7, 90, 360));
+    f = input.take();
+    expect([f.dragX, f.dragY]).toEqual([0, 0]);
+    input.dispose();
+  });
+
+  it('touch with a brush: a tap edits; a second finger takes the gesture back from the brush', () => {
+    const { canvas, input } = setup({ active: true });
+    canvas.dispatchEvent(touch('pointerdown', 3, 110, 120));
+    canvas.dispatchEvent(touch('pointerup', 3, 110, 120));
+    let f = input.take();
+    expect([f.brushPresses, f.brushRelease]).toEqual([[{ x: 100, y: 100 }], true]);
+    canvas.dispatchEvent(touch('pointerdown', 4, 110, 120));
+    canvas.dispatchEvent(touch('pointerdown', 5, 210, 120));
+    f = input.take();
+    expect(f.brushPresses).toEqual([]);
+    expect([f.brushRelease, input.brushHeld]).toEqual([true, false]);
     input.dispose();
   });
 });

@@ -2,16 +2,20 @@
 // each view with the sky on: the default planet, the earth preset and the real Earth (ETOPO5
 // with NASA's Visible Earth where installed, over the Bay of Naples) from orbit, 100 km (the
 // default planet: 1 km), 10 km (100 m), 100 m (10 m) and 2 m above the ground, and a sunset from
-// 30 m over the ground. Each descent is
+// 30 m over the ground; and the README's two pictures of the viewer with its HUD
+// (e2e/artifacts/readme-viewer-*.png; PMC_E2E_GALLERY_ONLY=viewer takes those alone). Each descent is
 // the levels-of-detail flight of steps 9 and 10 (no crack, no hole at any stop); the pictures
 // are e2e/artifacts/gallery-*-view.png and gallery-*-sunset.png.
 
-import { existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { DEM_SOURCE, PMC_BIN, check, cleanups, log, run } from '../harness.mjs';
+import { DEM_SOURCE, PMC_BIN, artifacts, check, cleanups, log, run } from '../harness.mjs';
 import { lodFlight } from '../lodFlight.mjs';
 import { startBackend } from '../servers.mjs';
+import { viewerModule } from '../viewerModule.mjs';
+
+const { headingPitchOf, positionFromLatLon, sub } = await viewerModule('frames.ts');
 
 export const name = '16. the gallery: the default planet, the earth preset and the real Earth from orbit to 2 m and at sunset, with the sky';
 
@@ -49,8 +53,34 @@ export async function scenario(t) {
     ...heights.slice(1).map((h) => ({ name: `${h}m`, height: h, pitch: pitches[h] ?? -15 })),
   ];
 
-  // PMC_E2E_GALLERY_ONLY=earthlike,earth,dem: some of the planets (while working on a look)
+  // PMC_E2E_GALLERY_ONLY=viewer,earthlike,earth,dem: some of the pictures (while working on a look)
   const only = (what) => !process.env.PMC_E2E_GALLERY_ONLY || process.env.PMC_E2E_GALLERY_ONLY.split(',').includes(what);
+
+  // the README's two pictures of the viewer as a first visit sees it (the HUD, the go-to box, the
+  // tool bar and the scale bar; the side panel folded away): the default planet from orbit, and
+  // the close-up of step 5 (a ridge with overhangs and cave mouths over a bay)
+  if (only('viewer')) {
+    const server = await startBackend(null);
+    await page.goto(`${server.url}#preset=earthlike&seed=7&mode=orbit&lat=20&lon=15&alt=3000`, { waitUntil: 'load', timeout: 60_000 });
+    await page.evaluate(() => localStorage.removeItem('pmc.panel'));
+    await page.reload({ waitUntil: 'load' });
+    await page.waitForFunction(() => window.__pmc !== undefined && window.__pmc.stats().preset === 'earthlike', null, { timeout: 60_000 });
+    await hook(() => window.__pmc.sky({ atmosphere: true, sunAzimuth: 135, sunElevation: 40 }));
+    await t.ready('the viewer from orbit');
+    // the HUD is refreshed five times a second
+    await page.waitForTimeout(500);
+    writeFileSync(join(artifacts, 'readme-viewer-orbit.png'), await page.screenshot());
+    const planet = await hook(() => fetch('api/v1/planet?preset=earthlike&seed=7').then((r) => r.json()));
+    const camRadius = 2250 * (planet.radius / 2000);
+    const camera = positionFromLatLon(3, 9, camRadius);
+    const { heading, pitch } = headingPitchOf(camera, sub(positionFromLatLon(-10, 8, planet.sea_radius), camera));
+    await hook(([h, p, a]) => window.__pmc.setCamera(3, 9, a, h, p), [heading, pitch, camRadius - planet.sea_radius]);
+    await t.ready('the viewer close to the ground');
+    await page.waitForTimeout(500);
+    writeFileSync(join(artifacts, 'readme-viewer-closeup.png'), await page.screenshot());
+    await page.goto('about:blank');
+    await server.stop();
+  }
 
   // the default planet (earthlike, seed 7: 1.9 km to the sea): grass 5 m over the sea, a beach
   // and a lake ahead, a snowy ridge beyond

@@ -180,6 +180,8 @@ export async function scenario(t) {
   check(it !== undefined && !it.main, `the overlay around the detached grid lacks component ${island.label}: ${JSON.stringify(g2.components.slice(0, 5))}`);
   check((g2.visible[island.label] ?? 0) > 0, `component ${island.label} is not visible from above: on screen ${g2.onScreen[island.label] ?? 0}, visible ${JSON.stringify(g2.visible)}`);
   const withGrid = await shot('navgrid-detached');
+  // the checkbox is in the side panel's Debug section
+  await t.openPanel(['debug']);
   await page.click('#navgrid');
   await waitFor(page, 'the nav grid off', () => !window.__pmc.navgrid().drawn, null, gridState, 10_000);
   const without = await shot('navgrid-off');

@@ -6,8 +6,10 @@ import { fractionDifferent } from '../images.mjs';
 export const name = '4. switching the preset (select → moon) changes the picture';
 
 export async function scenario(t) {
-  const { page, hook, ready, shot } = t;
+  const { page, hook, ready, shot, openPanel } = t;
   const { orbitImg } = t.shared;
+  // the preset picker is in the side panel (folded away on a first visit)
+  await openPanel(['planet']);
   await page.selectOption('#preset', 'moon');
   await page.waitForFunction(() => window.__pmc.stats().preset === 'moon', null, { timeout: 60_000 });
   const s = await ready('moon');

@@ -7,7 +7,8 @@ import { decodePng, fractionDifferent } from '../images.mjs';
 export const name = '6. debug views, mode switch, walk mode, the URL hash, the keyboard help and hiding the panels';
 
 export async function scenario(t) {
-  const { page, consoleProblems, expectedFailures, hook, ready, shot } = t;
+  const { page, consoleProblems, expectedFailures, hook, ready, shot, openPanel } = t;
+  await openPanel(['view', 'detail', 'debug', 'stats']);
   await hook(() => window.__pmc.setCamera(20, 15, 3000, 0, -90));
   await hook(() => window.__pmc.mode('orbit'));
   await ready('orbit again');
