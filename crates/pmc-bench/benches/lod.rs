@@ -1,5 +1,6 @@
 //! Level-of-detail chunks: a surface chunk at each level, and the cost of closing seams toward
-//! coarser neighbours (transition patches) against the same chunk meshed without them.
+//! coarser neighbours (transition patches) against the same chunk meshed without them; and the
+//! search for the chunks near a point (`GET /api/v1/chunks`) on the Earth at true scale.
 use criterion::{criterion_group, criterion_main, Criterion};
 use pmc_bench::default_planet;
 use pmc_geometry::{ChunkSide, SideMask};
@@ -40,5 +41,25 @@ fn lod(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, lod);
+/// `chunks_near` on `earth` (1 m voxels, a 32.8 km shell): 50 m at level 0 (about 60 chunks) and
+/// 20 km at level 4 (about 175 000 chunks), the two queries the API once refused.
+fn chunks_near(c: &mut Criterion) {
+    use pmc_planet::{Planet, PresetKind};
+    let layout = PresetKind::Earth.default_layout(None).expect("the earth's layout");
+    let planet = Planet::new(PresetKind::Earth, 7, layout);
+    let p = pmc_geometry::LatLon::new(39.0, 0.0).expect("a place").to_unit() * planet.datum_radius();
+    let mut g = c.benchmark_group("chunks_near");
+    g.sample_size(20);
+    for (level, range) in [(0u8, 50.0), (4, 20_000.0)] {
+        let total = pmc_lod::bounds::chunks_near(&planet, level, p, range, 512, 200_000)
+            .expect("in budget")
+            .1;
+        g.bench_function(format!("earth/level{level}/range={range}m/chunks={total}"), |b| {
+            b.iter(|| pmc_lod::bounds::chunks_near(&planet, level, p, range, 512, 200_000))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, lod, chunks_near);
 criterion_main!(benches);

@@ -23,11 +23,20 @@
 //!
 //! # Finding the chunks near a point
 //!
-//! Each face is searched as a quadtree over its chunk columns: a node's rectangle gets a sphere as
-//! above (over the whole shell), and a node is skipped when even `2 x` the largest possible chunk
-//! sphere cannot reach the query from it (a chunk sphere holds a chunk voxel, which lies in the node
-//! sphere, so its centre is within `node radius + chunk radius` of the node's centre). So the
-//! result is exactly the brute-force list, visiting only chunks near the point.
+//! Each face is searched as a quadtree over its chunk columns: a node's rectangle gets a cap as
+//! above, and a node is skipped when the nearest point of its part of the shell (the directions of
+//! the cap, the radii of the shell) lies farther from the query than the range plus `2 x` the
+//! largest possible chunk sphere (a chunk sphere that reaches within the range holds a voxel of
+//! the chunk, which lies in the node's part of the shell, within twice its radius of any of its
+//! points). In a column only the chunks whose layers come that near are looked at: the nearest
+//! distance is convex in the radius, so those chunks are consecutive, found from the layer nearest
+//! the query. So the result is exactly the brute-force list, visiting only chunks near the point:
+//! what the range reaches, not the shell's thickness (32.8 km on the Earth) around it.
+//!
+//! The nearest distance from `p` (radius `rho`, angle `theta` from the cap's axis) to a direction
+//! of the cap at radius `r`: the angle between them is at least `gamma = max(0, theta - angle)`,
+//! and `|p - d r|^2 = (r - rho)^2 + 4 r rho sin^2(gamma / 2)` is least at `r = rho cos gamma`
+//! (clamped to the radii).
 
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{face_uv_to_cube, face_uv_to_sphere, ChunkKey, Face, Layout};
@@ -42,6 +51,8 @@ pub const RADIUS_FACTOR: f64 = 1.02;
 const MAX_CAP_ANGLE: f64 = 1.5;
 /// Border samples per side of a quadtree node.
 const NODE_SAMPLES: u32 = 16;
+/// [`chunks_near`] tests at most this many chunks per chunk of its budget.
+const TESTED_PER_BUDGET: usize = 8;
 
 /// A sphere, in metres, planet-centred.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -245,7 +256,7 @@ pub struct ChunkHit {
     pub distance: f64,
 }
 
-/// The query was too broad: more chunks to consider than the budget.
+/// The query was too broad: more chunks in range than the budget.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TooManyChunks {
     /// The budget that was exceeded.
@@ -254,7 +265,8 @@ pub struct TooManyChunks {
 
 /// The chunks of `level` whose bounding spheres come within `range` of `point` and that may hold
 /// surface, nearest first (ties by key), with their total count; at most `limit` are returned.
-/// Fails when more than `budget` chunks would have to be tested.
+/// Fails when more than `budget` chunks lie in range. The work is in proportion to the chunks in
+/// range (and those within twice a chunk's size of it), not to the planet's or the shell's size.
 pub fn chunks_near(
     planet: &Planet,
     level: u8,
@@ -310,8 +322,7 @@ impl Search<'_> {
         let (n, s) = (self.layout.face_tiles(), span(self.layout, self.level));
         let t = |c: u32| uv(i64::from(c) * s, n);
         let cap = rect_cap(face, t(i0), t(i1), t(j0), t(j1), NODE_SAMPLES);
-        let sphere = cap_sphere(cap, self.layout.d_b(), self.layout.radius());
-        if (self.point - sphere.center).length() > self.range + sphere.radius + self.margin {
+        if cap_distance(cap, self.layout.d_b(), self.layout.radius(), self.point) > self.reach() {
             return Ok(());
         }
         let (im, jm) = (i0 + (i1 - i0).div_ceil(2), j0 + (j1 - j0).div_ceil(2));
@@ -321,10 +332,45 @@ impl Search<'_> {
         self.node(face, im, i1, jm, j1)
     }
 
-    /// Tests every chunk of the column `(face, i, j)`.
+    /// How near a chunk's voxels must come to the query for its sphere to reach within the range.
+    fn reach(&self) -> f64 {
+        // (and a little more for the rounding of the nearest distance)
+        self.range + self.margin + 1e-9 * self.layout.radius()
+    }
+
+    /// Tests the chunks of the column `(face, i, j)` whose layers come within reach of the query
+    /// (consecutive: see the module docs), from the chunk of the nearest radius outward.
     fn column(&mut self, face: Face, i: u32, j: u32) -> Result<(), TooManyChunks> {
         let cap = column_cap(self.layout, face, self.level, i, j);
-        for k in 0..self.layout.depth_chunks(self.level) {
+        let depth = self.layout.depth_chunks(self.level);
+        let near = |k: u32| {
+            let (r0, r1) = layer_range(self.layout, self.level, k);
+            cap_distance(cap, r0, r1, self.point)
+        };
+        // the chunk holding the radius nearest the query: the last whose bottom is at or below it
+        let target = nearest_radius(cap, self.point);
+        let (mut lo, mut hi) = (0u32, depth);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if layer_range(self.layout, self.level, mid).0 <= target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let start = lo;
+        if near(start) > self.reach() {
+            return Ok(());
+        }
+        let mut first = start;
+        while first > 0 && near(first - 1) <= self.reach() {
+            first -= 1;
+        }
+        let mut last = start;
+        while last + 1 < depth && near(last + 1) <= self.reach() {
+            last += 1;
+        }
+        for k in first..=last {
             let key = ChunkKey {
                 face,
                 level: self.level,
@@ -335,19 +381,44 @@ impl Search<'_> {
             if !self.planet.may_hold_surface(&key) {
                 continue;
             }
+            // (the chunks tested and not in range lie in the margin around the range: a few per
+            // chunk in range, more only for ranges under a chunk's size; a bound all the same)
             self.tested += 1;
-            if self.tested > self.budget {
+            if self.tested > self.budget.saturating_mul(TESTED_PER_BUDGET) {
                 return Err(TooManyChunks { budget: self.budget });
             }
             let (r0, r1) = layer_range(self.layout, self.level, k);
             let sphere = cap_sphere(cap, r0, r1);
             let distance = sphere.distance(self.point);
             if distance <= self.range {
+                if self.hits.len() >= self.budget {
+                    return Err(TooManyChunks { budget: self.budget });
+                }
                 self.hits.push(ChunkHit { key, sphere, distance });
             }
         }
         Ok(())
     }
+}
+
+/// The least angle between direction `p` and a direction of `cap` (0 when `p` lies in it).
+fn cap_gap(cap: Cap, p: DVec3) -> f64 {
+    let theta = cap.axis.cross(p).length().atan2(cap.axis.dot(p));
+    (theta - cap.angle).max(0.0)
+}
+
+/// The radius at which the points of `cap`'s directions come nearest `p` (`rho cos gamma`, see
+/// the module docs; not clamped to any shell).
+fn nearest_radius(cap: Cap, p: DVec3) -> f64 {
+    p.length() * cap_gap(cap, p).cos()
+}
+
+/// The least distance from `p` to a point `d r` with `d` in `cap` and `r` in `[r0, r1]`.
+fn cap_distance(cap: Cap, r0: f64, r1: f64, p: DVec3) -> f64 {
+    let rho = p.length();
+    let gamma = cap_gap(cap, p);
+    let r = (rho * gamma.cos()).clamp(r0, r1.max(r0));
+    dist2(r, rho, (0.5 * gamma).sin()).sqrt()
 }
 
 #[cfg(test)]
@@ -488,6 +559,89 @@ mod tests {
             let expected = brute_force(&planet, level, p, range);
             prop_assert_eq!(total, expected.len());
             prop_assert_eq!(hits, expected);
+        }
+
+        /// A shell many chunks deep (sixteen level-0 chunks) over a small core: the search walks
+        /// each column's chunks from the nearest radius, and must still find every one in range,
+        /// from inside the core, in the shell and far outside.
+        #[test]
+        fn deep_shells_search_equals_brute_force(
+            dir in [-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0],
+            dist in 0.0f64..2.5,
+            range in 0.1f64..150.0,
+            level in 0u8..5,
+            preset in 0usize..3,
+        ) {
+            let layout = Layout::new(8, 4, 60.0, 1.0, 16).unwrap();
+            let kind = [PresetKind::Sphere, PresetKind::Earthlike, PresetKind::Moon][preset];
+            let planet = Planet::new(kind, 5, layout);
+            let level = level.min(layout.max_level());
+            let d = DVec3::from_array(dir);
+            let p = if d.length() < 1e-6 { DVec3::ZERO } else { d.normalize() * dist * layout.radius() };
+            let (hits, total) = chunks_near(&planet, level, p, range, usize::MAX, usize::MAX).unwrap();
+            let expected = brute_force(&planet, level, p, range);
+            prop_assert_eq!(total, expected.len());
+            prop_assert_eq!(hits, expected);
+        }
+    }
+
+    /// The least distance to a cap's part of a shell is never more than the distance to any of
+    /// its points (sampled), and is that distance for a point straight under the query.
+    #[test]
+    fn cap_distance_is_a_lower_bound() {
+        let layout = Layout::new(8, 4, 60.0, 1.0, 16).unwrap();
+        let (r0, r1) = (layout.d_b(), layout.radius());
+        let mut worst_gap: f64 = f64::INFINITY;
+        for face in Face::ALL {
+            let cap = rect_cap(face, -0.3, 0.1, 0.2, 0.7, 16);
+            for q in [
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(10.0, -80.0, 40.0),
+                DVec3::new(150.0, 20.0, -30.0),
+                cap.axis * 100.0,
+                cap.axis * 20.0,
+            ] {
+                let bound = cap_distance(cap, r0, r1, q);
+                for a in 0..=20 {
+                    for b in 0..=20 {
+                        let (u, v) = (-0.3 + 0.4 * f64::from(a) / 20.0, 0.2 + 0.5 * f64::from(b) / 20.0);
+                        let d = face_uv_to_sphere(face, u, v).normalize();
+                        for c in 0..=8 {
+                            let r = r0 + (r1 - r0) * f64::from(c) / 8.0;
+                            let gap = (q - d * r).length() - bound;
+                            assert!(gap >= -1e-9, "{face:?} {q}: a point {gap} nearer than the bound");
+                            worst_gap = worst_gap.min(gap);
+                        }
+                    }
+                }
+            }
+            assert_eq!(cap_distance(cap, r0, r1, cap.axis * 100.0), 0.0);
+            assert!((cap_distance(cap, r0, r1, cap.axis * 130.0) - (130.0 - r1)).abs() < 1e-9);
+        }
+        assert!(worst_gap < 1.0, "the bound is loose by {worst_gap} m");
+    }
+
+    /// `GET /api/v1/chunks` on `earth` refused a 50 m range at level 0 and a 20 km range at level 4
+    /// ("more than 200000 chunks lie near the point"): the search visited every column within the
+    /// shell's 32.8 km thickness, and all its chunks. Now what the range reaches is visited: 54 to
+    /// 60 chunks within 50 m at level 0, and at level 4 the 170 000 to 180 000 chunks within 20 km
+    /// that the terrain's radial bounds (11 km under the sea to 9 km over it) leave in.
+    #[test]
+    fn the_earth_chunks_near_a_point_at_fine_and_coarse_levels() {
+        let layout = PresetKind::Earth.default_layout(None).unwrap();
+        let planet = Planet::new(PresetKind::Earth, 7, layout);
+        for (lat, lon) in [(39.0, 0.0), (27.99, 86.93), (-10.0, 120.0)] {
+            let ground = pmc_geometry::LatLon::new(lat, lon).unwrap().to_unit() * planet.datum_radius();
+            for (level, range) in [(0u8, 50.0), (4, 20_000.0)] {
+                let (hits, total) = chunks_near(&planet, level, ground, range, 4096, 200_000).unwrap();
+                assert!(
+                    total > 0 && hits.len() == total.min(4096),
+                    "{lat},{lon} L{level}: {total}"
+                );
+                // a 50 m range at level 0 (32 m chunks): a few columns, a few chunks deep
+                assert!(level != 0 || total < 200, "{lat},{lon}: {total} chunks within 50 m");
+                assert!(hits.iter().all(|h| h.distance <= range && h.key.level == level));
+            }
         }
     }
 

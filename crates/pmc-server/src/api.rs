@@ -123,8 +123,8 @@ pub async fn chunks(State(state): State<AppState>, RawQuery(q): RawQuery) -> Res
         .map_err(|e| ApiError::internal(format!("the chunk search failed: {e}")))?;
     let (hits, total) = found.map_err(|TooManyChunks { budget }| {
         ApiError::bad_request(format!(
-            "range {range} m is too large for this planet: more than {budget} chunks of level {level} lie near the \
-             point; lower range or ask for a coarser level"
+            "range {range} m is too large for this planet: more than {budget} chunks of level {level} lie within range \
+             of the point; lower range or ask for a coarser level"
         ))
     })?;
     let chunks: Vec<Value> = hits

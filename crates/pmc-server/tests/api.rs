@@ -515,3 +515,42 @@ async fn lod_chunks_close_the_seams_they_are_asked_for() {
         assert!(String::from_utf8_lossy(&r.body).contains("seams"));
     }
 }
+
+/// `GET /api/v1/chunks` on `earth` refused a 50 m range at level 0 and a 20 km range at level 4
+/// ("more than 200000 chunks ... lie near the point"): the search went through the shell's whole
+/// thickness around the point. Both answer now, and a range with more chunks than the budget is
+/// still refused with the reason.
+#[tokio::test]
+async fn the_earth_answers_chunks_near_a_point_at_fine_and_coarse_levels() {
+    let layout = PresetKind::Earth.default_layout(None).unwrap();
+    let a = app(ServerConfig {
+        port: 0,
+        terrain: pmc_planet::TerrainSpec::preset(PresetKind::Earth, 7),
+        layout,
+        threads: 2,
+        ..ServerConfig::default()
+    });
+    let p = pmc_geometry::LatLon::new(39.0, 0.0).unwrap().to_unit() * 6_371_000.0;
+    for (level, range) in [(0u8, 50.0), (4, 20_000.0)] {
+        let uri = format!(
+            "/api/v1/chunks?x={}&y={}&z={}&range={range}&level={level}",
+            p.x, p.y, p.z
+        );
+        let r = get(&a, &uri).await;
+        assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
+        let v = r.json();
+        let total = v["total_in_range"].as_u64().unwrap();
+        let listed = v["chunks"].as_array().unwrap();
+        assert!(
+            total > 0 && listed.len() as u64 == total.min(512),
+            "level {level}: {total}"
+        );
+        assert!(listed
+            .iter()
+            .all(|c| c["distance"].as_f64().unwrap() <= range && c["level"] == level));
+    }
+    let uri = format!("/api/v1/chunks?x={}&y={}&z={}&range=200000&level=4", p.x, p.y, p.z);
+    let r = get(&a, &uri).await;
+    assert_eq!(r.status, StatusCode::BAD_REQUEST);
+    assert!(String::from_utf8_lossy(&r.body).contains("more than 200000 chunks of level 4 lie within range"));
+}
