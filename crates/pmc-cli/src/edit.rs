@@ -34,7 +34,7 @@ pub enum BrushName {
 /// Options of `pmc edit`.
 #[derive(Args, Debug)]
 pub struct EditArgs {
-    /// The world file (SQLite, format pmc-world v1). Applying a brush to a missing file creates
+    /// The world file (SQLite, format pmc-world v2, docs/specs/world-sqlite-v2.md). Applying a brush to a missing file creates
     /// it with the planet options; an existing file keeps its own planet.
     #[arg(long, value_name = "FILE")]
     world: PathBuf,

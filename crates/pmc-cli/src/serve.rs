@@ -38,7 +38,7 @@ pub struct ServeArgs {
     #[arg(long = "cache-mb", default_value_t = 512, value_name = "MIB")]
     cache_mb: u64,
 
-    /// Serve and edit this world file (SQLite, format pmc-world v1; see `pmc edit`): the viewer
+    /// Serve and edit this world file (SQLite, format pmc-world v2; see `pmc edit`): the viewer
     /// gets its dig, build, smooth, flatten and paint tools, and every edit is saved durably. A
     /// missing file is created with the planet options; an existing one keeps its own planet
     /// (planet options given must agree with it).

@@ -93,7 +93,9 @@ fn all_rows(src: &dyn EquirectSource) -> bool {
     true
 }
 
-fn parse_netcdf(bytes: &[u8]) -> bool {
+/// Reads `bytes` as a netCDF classic grid in memory (a grid checked for consistency, or a refusal
+/// naming the file `fuzz`); whether it was accepted. Panics only on a bug.
+pub fn parse_netcdf(bytes: &[u8]) -> bool {
     match EquirectDem::from_netcdf_bytes("fuzz", bytes.to_vec(), None) {
         Ok(dem) => {
             consistent(&dem);
@@ -106,7 +108,8 @@ fn parse_netcdf(bytes: &[u8]) -> bool {
     }
 }
 
-fn parse_netcdf_source(bytes: &[u8]) -> bool {
+/// Reads `bytes` as a netCDF classic source, every row in bands; whether all were read.
+pub fn parse_netcdf_source(bytes: &[u8]) -> bool {
     match NetcdfSource::from_bytes("fuzz", bytes.to_vec(), None) {
         Ok(src) => all_rows(&src),
         Err(e) => {
@@ -116,7 +119,8 @@ fn parse_netcdf_source(bytes: &[u8]) -> bool {
     }
 }
 
-fn parse_geotiff(bytes: &[u8]) -> bool {
+/// Reads `bytes` as a GeoTIFF grid in memory; whether it was accepted.
+pub fn parse_geotiff(bytes: &[u8]) -> bool {
     match EquirectDem::from_geotiff_bytes("fuzz", bytes.to_vec()) {
         Ok(dem) => {
             consistent(&dem);
@@ -129,7 +133,8 @@ fn parse_geotiff(bytes: &[u8]) -> bool {
     }
 }
 
-fn parse_geotiff_source(bytes: &[u8]) -> bool {
+/// Reads `bytes` as a GeoTIFF source, every row in bands; whether all were read.
+pub fn parse_geotiff_source(bytes: &[u8]) -> bool {
     match GeoTiffSource::from_bytes("fuzz", bytes.to_vec()) {
         Ok(src) => all_rows(&src),
         Err(e) => {
@@ -139,7 +144,8 @@ fn parse_geotiff_source(bytes: &[u8]) -> bool {
     }
 }
 
-fn parse_png(bytes: &[u8]) -> bool {
+/// Reads `bytes` as a 16-bit PNG grid with [`PNG_EXTENT`]; whether it was accepted.
+pub fn parse_png(bytes: &[u8]) -> bool {
     match EquirectDem::from_png16_bytes("fuzz", bytes, &PNG_EXTENT) {
         Ok(dem) => {
             consistent(&dem);
@@ -161,7 +167,9 @@ thread_local! {
     ));
 }
 
-fn parse_pmcdem(bytes: &[u8]) -> bool {
+/// Writes `bytes` to a file of this thread and opens it as a `.pmcdem`, asks for heights
+/// anywhere and verifies every tile; whether it was accepted whole.
+pub fn parse_pmcdem(bytes: &[u8]) -> bool {
     PMCDEM_PATH.with(|path| {
         if std::fs::write(path, bytes).is_err() {
             return false;

@@ -166,6 +166,9 @@ pub enum ChunkDecodeError {
     /// A padding byte is not zero.
     #[error("padding after the {0} section is not zero")]
     Padding(&'static str),
+    /// The origin is not finite (NaN or infinite): no vertex of the chunk could be placed.
+    #[error("the origin {0} is not finite")]
+    Origin(String),
     /// A triangle index is not below the vertex count.
     #[error("index {value} at position {position} is out of range for {vertices} vertices")]
     IndexOutOfRange {
@@ -403,6 +406,9 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
     }
     let (i, j, k) = (r.u32(), r.u32(), r.u32());
     let origin = DVec3::new(r.f64(), r.f64(), r.f64());
+    if !origin.is_finite() {
+        return Err(ChunkDecodeError::Origin(format!("({}, {}, {})", origin.x, origin.y, origin.z)));
+    }
     let v32 = r.u32();
     let i32_ = r.u32();
     if !i32_.is_multiple_of(3) {

@@ -693,3 +693,29 @@ fn an_unknown_terrain_is_refused_untouched() {
         .unwrap();
     assert_refused(&q, |e| matches!(e, WorldError::Corrupt { .. }), "seed");
 }
+
+/// Another program holding the world locked (an exclusive transaction, as `sqlite3` leaves one
+/// open): opening it, and an edit on a world already open, are refused after the busy timeout
+/// with the reason and the file's name; the edits already in it are all there once the lock goes.
+#[test]
+fn a_world_locked_by_another_program_is_refused_with_the_reason_and_loses_nothing() {
+    let d = dir("locked");
+    let (p, mut w) = new_world(&d);
+    let a = op(BrushKind::Add, 0.0, 0.0, 201.0, 3.0, 1.0);
+    w.append(&a).unwrap();
+    let other = Connection::open(&p).unwrap();
+    other.execute_batch("BEGIN EXCLUSIVE").unwrap();
+    let e = World::open(&p).unwrap_err();
+    let shown = e.to_string();
+    assert!(shown.contains("another program holds the world locked"), "{shown}");
+    assert!(shown.contains(&p.display().to_string()), "{shown}");
+    let e = w.append(&op(BrushKind::Remove, 0.0, 201.0, 0.0, 3.0, 1.0)).unwrap_err();
+    assert!(e.to_string().contains("another program holds the world locked"), "{e}");
+    other.execute_batch("ROLLBACK").unwrap();
+    drop(other);
+    assert_eq!(w.active_edits().unwrap(), vec![a]);
+    drop(w);
+    let w = World::open(&p).unwrap();
+    assert_eq!(w.active_edits().unwrap(), vec![a]);
+    w.integrity_check().unwrap();
+}

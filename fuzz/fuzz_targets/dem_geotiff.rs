@@ -1,0 +1,3 @@
+//! GeoTIFF elevation grids (strips, tiles, deflate, LZW), read whole and as a source of rows.
+#![no_main]
+libfuzzer_sys::fuzz_target!(|data: &[u8]| pmc_fuzz::dem_geotiff(data));
