@@ -538,3 +538,93 @@ fn generate_exports_the_edited_world() {
     assert!(!text(&o.stderr).contains("panicked"));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The disk filling during edits: `pmc edit --repeat` appends edits under a file size limit
+/// (`prlimit --fsize`, with SIGXFSZ ignored, so that a write past the limit fails as on a full
+/// disk) a few pages over the world's size. The edit that no longer fits is refused with a clear
+/// error naming the world, the command fails with exit code 1 (not a panic, not a signal), and the world reopens
+/// sound with every acknowledged edit exact; then, the limit gone, editing goes on.
+#[cfg(target_os = "linux")]
+#[test]
+fn the_disk_filling_refuses_the_edit_and_keeps_every_acknowledged_one() {
+    use std::process::Stdio;
+    if Command::new("prlimit").arg("--version").output().is_err() {
+        panic!("this test needs prlimit (util-linux)");
+    }
+    let d = dir("disk-full");
+    let w = d.join("w.world");
+    let mut args = PLANET.to_vec();
+    args.extend(["add", "--at", "0,0,0", "--radius", "1"]);
+    edit_ok(&w, &args);
+    let size = std::fs::metadata(&w).unwrap().len();
+    let limit = size + 16 * 1024;
+    let round = Round::new(3);
+    let at = format!("--at={},{},{}", round.lat, round.lon, round.alt);
+    let script = format!("trap '' XFSZ; exec prlimit --fsize={limit} -- \"$0\" \"$@\"",);
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(&script)
+        .arg(env!("CARGO_BIN_EXE_pmc"))
+        .args(["edit", "--world", w.to_str().unwrap()])
+        .args(PLANET)
+        .args([round.brush, at.as_str(), "--radius", &round.radius.to_string()])
+        .args(["--strength", &round.strength.to_string(), "--repeat", "100000"])
+        .stdin(Stdio::null())
+        .output()
+        .expect("pmc runs under prlimit");
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    let acked = applied_ids(&out);
+    // exit code 1: the system failed (2 is for bad input)
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "pmc did not refuse the edit cleanly: {:?}: {err}",
+        o.status
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains(w.to_str().unwrap()),
+        "the error does not name the world: {err}"
+    );
+    assert!(
+        err.contains("could not write") && err.contains("nothing of it was saved"),
+        "{err}"
+    );
+    assert!(
+        acked.len() >= 5,
+        "too few edits before the disk filled: {}",
+        acked.len()
+    );
+    eprintln!(
+        "{} edits acknowledged before the limit ({limit} bytes): {}",
+        acked.len(),
+        err.trim()
+    );
+
+    let world = World::open(&w).unwrap();
+    world.integrity_check().unwrap();
+    let entries = world.entries().unwrap();
+    let new: Vec<_> = entries.iter().filter(|e| e.id.0 > 1).collect();
+    assert_eq!(
+        new.len(),
+        acked.len(),
+        "acknowledged {}, in the file {}",
+        acked.len(),
+        new.len()
+    );
+    let datum = planet().datum_radius();
+    for (k, e) in new.iter().enumerate() {
+        assert_eq!(e.id.0, acked[k]);
+        assert_eq!(
+            op_bits(&e.op),
+            op_bits(&round.op(datum, k as u64)),
+            "edit {} differs",
+            e.id
+        );
+    }
+    drop(world);
+    // no journal left beside it, and editing goes on once there is room
+    assert!(!d.join("w.world-journal").exists());
+    let (out, _) = edit_ok(&w, &["--undo"]);
+    assert!(out.contains("undid"), "{out}");
+}

@@ -407,7 +407,10 @@ pub fn decode_chunk(bytes: &[u8]) -> Result<DecodedChunk, ChunkDecodeError> {
     let (i, j, k) = (r.u32(), r.u32(), r.u32());
     let origin = DVec3::new(r.f64(), r.f64(), r.f64());
     if !origin.is_finite() {
-        return Err(ChunkDecodeError::Origin(format!("({}, {}, {})", origin.x, origin.y, origin.z)));
+        return Err(ChunkDecodeError::Origin(format!(
+            "({}, {}, {})",
+            origin.x, origin.y, origin.z
+        )));
     }
     let v32 = r.u32();
     let i32_ = r.u32();

@@ -372,5 +372,8 @@ fn fuzz_findings_are_refused_or_consistent() {
     assert!(seen >= 1, "no inputs under {}", dir.display());
     let nan = std::fs::read(dir.join("nan-origin")).unwrap();
     let e = pmc_formats::chunk_encoding::decode_chunk(&nan).unwrap_err();
-    assert!(e.to_string().contains("origin") && e.to_string().contains("not finite"), "{e}");
+    assert!(
+        e.to_string().contains("origin") && e.to_string().contains("not finite"),
+        "{e}"
+    );
 }

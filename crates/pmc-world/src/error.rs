@@ -134,13 +134,31 @@ fn sqlite_hint(e: &rusqlite::Error) -> &'static str {
             "another program holds the world locked; close it and try again"
         }
         Some(ErrorCode::ReadOnly) => "the world or its directory is read-only; make both writable",
-        Some(ErrorCode::DiskFull) => "the disk is full; free some space and try again",
+        Some(ErrorCode::DiskFull) => {
+            "the disk is full: could not write; nothing of it was saved: free some space and try again"
+        }
         Some(ErrorCode::CannotOpen | ErrorCode::PermissionDenied) => {
             "check that the file and its directory exist and are readable and writable"
+        }
+        Some(ErrorCode::SystemIoFailure) if is_write_failure(e) => {
+            "could not write to the disk (full, or past a file size limit); nothing of it was saved: free \
+             some space and try again"
         }
         Some(ErrorCode::SystemIoFailure) => "the disk reported an I/O error; check it and try again",
         _ => "try again; if it persists, check the file with `sqlite3 FILE 'PRAGMA integrity_check'`",
     }
+}
+
+/// Whether `e` is SQLite failing to write, sync or grow a file (`SQLITE_IOERR_WRITE`, `_FSYNC`,
+/// `_TRUNCATE`, `_SHORT_READ` aside): what a full disk or a file size limit gives.
+fn is_write_failure(e: &rusqlite::Error) -> bool {
+    use rusqlite::ffi;
+    matches!(
+        e,
+        rusqlite::Error::SqliteFailure(f, _)
+            if [ffi::SQLITE_IOERR_WRITE, ffi::SQLITE_IOERR_FSYNC, ffi::SQLITE_IOERR_TRUNCATE, ffi::SQLITE_IOERR_DIR_FSYNC]
+                .contains(&f.extended_code)
+    )
 }
 
 /// The result type of this crate.
