@@ -15,7 +15,7 @@ import { EditSession, type EditStatus } from './editSession';
 import { toolByName, type ToolName } from './editTools';
 import { bookmarkName, loadBookmarks, saveBookmarks, withBookmark, withoutBookmark, type Bookmark } from './bookmarks';
 import { Flight, parseGoTo, type GoToTarget } from './goTo';
-import { planetName } from './planetName';
+import { planetIdentity, planetName } from './planetName';
 import { shortcutOf } from './shortcuts';
 import { length, normalize, type V3 } from './frames';
 import { FrameLoop } from './frameLoop';
@@ -91,7 +91,7 @@ export class App implements TestHookTarget {
   private lastHashWrite = 0;
   private writtenHash = '';
   private error: string | null = null;
-  /** The `/planet` answer shown (to tell, back online, whether the server serves another planet). */
+  /** The planet shown, as `planetIdentity` writes it (to tell, back online, whether the server serves another). */
   private planetJson = '';
   /** Whether the server answers (the notice and the retry when it does not). */
   readonly connection: ConnectionMonitor;
@@ -111,7 +111,10 @@ export class App implements TestHookTarget {
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.connection = new ConnectionMonitor({
       probe: () => this.api.health().then(() => undefined),
-      onChange: () => this.showConnection(),
+      onChange: (s) => {
+        this.streamer.setPaused(!s.online);
+        this.showConnection();
+      },
       onOnline: () => this.resume(),
     });
     this.api.observer = this.connection;
@@ -325,7 +328,7 @@ export class App implements TestHookTarget {
   }
 
   private applyPlanet(info: PlanetInfo): void {
-    this.planetJson = JSON.stringify(info);
+    this.planetJson = planetIdentity(info);
     this.params = planetParams(info);
     this.planetTitle = planetName(info);
     document.title = `${this.planetTitle} — PMC`;
@@ -452,7 +455,7 @@ export class App implements TestHookTarget {
     void this.api
       .planet(choice)
       .then((info) => {
-        if (choice === this.choice && JSON.stringify(info) !== this.planetJson) void this.loadPlanet(choice, true);
+        if (choice === this.choice && planetIdentity(info) !== this.planetJson) void this.loadPlanet(choice, true);
       })
       .catch(() => undefined);
   }

@@ -167,9 +167,22 @@ export class ChunkStreamer {
     this.now = opts.now ?? (() => performance.now());
   }
 
+  /**
+   * While the server does not answer (connection.ts), no chunk is requested: the connection's
+   * probe finds out when it is back, rather than every missing chunk on its own back-off.
+   */
+  private paused = false;
+
+  /** Stops requesting chunks (the server is gone), or starts again. */
+  setPaused(paused: boolean): void {
+    this.paused = paused;
+    if (!paused) this.pump();
+  }
+
   /** Forgets the failures' back-off and requests what is missing now (the server is back). */
   retryFailed(): void {
     this.failures.clear();
+    this.paused = false;
     this.pump();
   }
 
@@ -316,7 +329,7 @@ export class ChunkStreamer {
 
   /** Asks for the most urgent chunks not loaded yet, up to the limit of requests in flight. */
   private pump(): void {
-    if (this.lod === null) return;
+    if (this.lod === null || this.paused) return;
     const now = this.now();
     const free = (): boolean => this.pending.size < this.maxConcurrent;
     // refetches of edited chunks come first: the user is looking at them

@@ -35,3 +35,12 @@ export function planetName(info: PlanetInfo): string {
   const edit = info.edit;
   return edit && edit.enabled ? `${edit.world} · ${name}` : name;
 }
+
+/**
+ * What makes a `/planet` answer another planet: everything but the world's edit counts (an edit
+ * made meanwhile comes through the edit stream, not as a new planet).
+ */
+export function planetIdentity(info: PlanetInfo): string {
+  const { edit, ...rest } = info;
+  return JSON.stringify({ ...rest, edit: edit ? { enabled: edit.enabled } : null });
+}

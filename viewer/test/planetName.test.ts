@@ -1,7 +1,7 @@
 import { describe, expect, it } from 'vitest';
 import type { PlanetInfo } from '../src/api';
 import { EARTHLIKE_INFO } from './fixtures';
-import { bodyOfRadius, planetName } from '../src/planetName';
+import { bodyOfRadius, planetIdentity, planetName } from '../src/planetName';
 
 const preset: PlanetInfo = EARTHLIKE_INFO;
 
@@ -38,5 +38,19 @@ describe('planet names', () => {
     expect(bodyOfRadius(6_371_000 * 1.05)).toBe('radius 6,690 km');
     expect(bodyOfRadius(1884.8)).toBe('radius 1,885 m');
     expect(bodyOfRadius(1_737_400)).toBe('the Moon');
+  });
+
+  it('tells another planet from the same one edited meanwhile (the viewer back online)', () => {
+    const edit = {
+      enabled: true as const, world: 'my.pmcw', revision: 3, active: 3, redo: 0, min_brush_radius: 0.5,
+      max_brush_radius: 64, rate_per_second: 5, burst: 10, brushes: ['add'],
+    };
+    const before = planetIdentity({ ...preset, edit });
+    // edits made meanwhile: the same planet (the edit stream brings them)
+    expect(planetIdentity({ ...preset, edit: { ...edit, revision: 5, active: 4, redo: 1 } })).toBe(before);
+    // another seed, another world's state (no editing), another layout: another planet
+    expect(planetIdentity({ ...preset, seed: '8', edit })).not.toBe(before);
+    expect(planetIdentity({ ...preset, edit: { enabled: false, reason: 'no world' } })).not.toBe(before);
+    expect(planetIdentity({ ...preset, edit, radius: preset.radius + 1 })).not.toBe(before);
   });
 });

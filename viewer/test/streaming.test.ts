@@ -135,6 +135,32 @@ describe('ChunkStreamer: what is fetched', () => {
     expect(errors).toEqual([]);
   });
 
+  it('requests nothing while the server is gone (paused), and what is missing at once when it is back', async () => {
+    const server = chunkServer();
+    let clock = 0;
+    const { s, shown, errors, step } = streamerOn(server, { now: () => clock });
+    server.fail(TOP, 1);
+    s.setSelection(selection(), VIEW);
+    await step(2);
+    await server.releaseAll();
+    await step(2);
+    expect(s.stats().failed).toBe(1);
+    const asked = server.requests.length;
+    s.setPaused(true);
+    clock += 60_000; // long past any back-off
+    await step(3);
+    expect(server.requests.length).toBe(asked);
+    // back: the failed chunk goes now, not after its back-off
+    clock -= 59_999;
+    s.retryFailed();
+    await step(2);
+    await server.releaseAll();
+    await step();
+    expect(server.requests.length).toBe(asked + 1);
+    expect(shown.has(TOP)).toBe(true);
+    expect(errors).toEqual([]);
+  });
+
   it('counts an empty chunk as loaded', async () => {
     const server = chunkServer();
     const { s, shown, step } = streamerOn(server);
@@ -349,6 +375,21 @@ describe('PmcApi', () => {
     expect(err).toBeInstanceOf(ApiError);
     expect((err as ApiError).transient).toBe(true);
     expect((err as Error).message).toMatch(/cannot reach the PMC server/);
+  });
+
+  it('tells its observer whether requests reach the server: a network failure or a proxy 502/504 no, any other answer yes', async () => {
+    const seen: string[] = [];
+    let answer: () => Promise<Response> = async () => { throw new TypeError('fetch failed'); };
+    const api = new PmcApi('/api/v1', () => answer());
+    api.observer = { reached: () => seen.push('reached'), unreachable: () => seen.push('unreachable') };
+    await api.health().catch(() => undefined);
+    answer = async () => new Response('', { status: 502 });
+    await api.health().catch(() => undefined);
+    answer = async () => new Response(JSON.stringify({ error: 'busy' }), { status: 503 });
+    await api.health().catch(() => undefined);
+    answer = async () => new Response(JSON.stringify({ ok: true, version: '1' }), { status: 200 });
+    await api.health();
+    expect(seen).toEqual(['unreachable', 'unreachable', 'reached', 'reached']);
   });
 
   it('rejects a chunk that does not decode, naming it', async () => {

@@ -5,16 +5,33 @@
 // says where the camera is; the side panel opens, remembers that and its folded sections over a
 // reload. On the phone (Playwright's touch emulation, touches sent as the browser gets them): one
 // finger turns the planet, a pinch zooms, two fingers moved up together tilt. Then the server is
-// stopped under a viewer: the notice says so, and once the server is back its Retry button
-// reconnects and the view converges.
+// stopped under a viewer (with a world): the notice says so; once the server is back, an edit is
+// made through the API while the page is still offline, and the Retry button reconnects: the
+// page's edit stream resumes (it learns the new revision and reloads the edit's chunks) and the
+// view converges.
 
-import { writeFileSync } from 'node:fs';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import { CHROMIUM, CHROMIUM_ARGS, LAYOUT, READY_MS, artifacts, check, cleanups, log, withTimeout } from '../harness.mjs';
 import { startBackend, startPmcServe } from '../servers.mjs';
+import { viewerModule } from '../viewerModule.mjs';
 
 export const name = '17. the overlays at 1024 x 640, 1920 x 1080 and on a phone (coverage, no overlap, the side panel remembered, touch), the server gone and back';
+
+const { positionFromLatLon } = await viewerModule('frames.ts');
+
+/**
+ * An edit body for `POST /api/v1/edits`: a ball of 4 m dug at the datum under (`lat`, `lon`)
+ * (the planet frame by the viewer's own frames.ts).
+ */
+async function editAt(base, lat, lon) {
+  const planet = await (await fetch(`${base}api/v1/planet`)).json();
+  const datum = planet.sea_radius ?? (planet.base_radius + planet.radius) / 2;
+  const [x, y, z] = positionFromLatLon(lat, lon, datum);
+  return { brush: 'remove', x, y, z, radius: 4 };
+}
 
 /** The largest share of a 1024 x 640 window the first visit's overlays may cover. */
 const MAX_COVERAGE = 0.15;
@@ -227,16 +244,23 @@ export async function scenario(t) {
 
   // ---- the server gone and back --------------------------------------------------------------
   {
-    const server = await startBackend(LAYOUT);
+    // with a world: the edit stream must resume too
+    const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-reconnect-'));
+    cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
+    const world = join(dir, 'reconnect.pmcw');
+    const server = await startBackend(LAYOUT, { world });
     const port = Number(new URL(server.api).port);
     const { context, page } = await open({ width: 1024, height: 640 });
-    await page.goto(`${server.url}#preset=earthlike&seed=7&mode=orbit&lat=20&lon=15&alt=3000`, { waitUntil: 'load', timeout: 60_000 });
+    await page.goto(`${server.url}#preset=earthlike&seed=7&mode=orbit&lat=-40&lon=120&alt=3000`, { waitUntil: 'load', timeout: 60_000 });
     await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
     await ready(page, 'before the server stops');
     const before = problems.length;
+    // the edit someone will make while the page is away, under the camera (its body computed now,
+    // on the first server)
+    const body = JSON.stringify(await editAt(server.api, -40, 120));
     await server.stopApi();
-    // the user moves on: what the view wants next cannot be fetched
-    await page.evaluate(() => window.__pmc.setCamera(-40, 120, 3000, 0, -90));
+    // the user zooms in: what the view wants next cannot be fetched
+    await page.evaluate(() => window.__pmc.setCamera(-40, 120, 1500, 0, -90));
     await page.waitForFunction(() => !window.__pmc.stats().online && !document.getElementById('offline').hidden, null, { timeout: 30_000 });
     const notice = await page.textContent('#offline-text');
     log(`  server stopped: "${notice}"`);
@@ -244,14 +268,22 @@ export async function scenario(t) {
     // probes 1, 2 and 4 s apart fail; the next waits 8 s
     await page.waitForFunction(() => /trying again in 8 s/.test(document.getElementById('offline-text').textContent), null, { timeout: 30_000 });
     check((await stats(page)).error === null, `a chunk error shows beside the notice: ${(await stats(page)).error}`);
-    const again = await startPmcServe(LAYOUT, { port });
+    const again = await startPmcServe(LAYOUT, { port, world });
+    // someone edits the world while the page is still offline: the page must learn of it
+    const rev0 = (await stats(page)).edit.revision;
+    const edit = await fetch(`${again.base}api/v1/edits`, { method: 'POST', headers: { 'content-type': 'application/json' }, body });
+    check(edit.status === 200, `the edit through the API: ${edit.status} ${await edit.text()}`);
+    check(!(await stats(page)).online, 'the page came back online before its Retry button could be tried (the next probe was 8 s away)');
     const t0 = Date.now();
-    await page.click('#offline-retry');
+    await page.click('#offline-retry', { timeout: 5_000 });
     // back before the next scheduled probe (8 s after the last): the button's doing
     await page.waitForFunction(() => window.__pmc.stats().online && document.getElementById('offline').hidden, null, { timeout: 5_000 });
     log(`  server back on port ${port}: online again ${((Date.now() - t0) / 1000).toFixed(1)} s after Retry`);
+    await page.waitForFunction((r) => window.__pmc.stats().edit.revision === r, rev0 + 1, { timeout: 30_000 });
     const r = await ready(page, 'after reconnecting');
+    log(`  the edit made while the page was away: revision ${rev0} -> ${r.edit.revision} in the page, its chunks reloaded: ${r.reloads}`);
     check(r.error === null && Math.abs(r.lat + 40) < 1e-6 && r.loaded > 0, `the view did not converge after reconnecting: ${JSON.stringify([r.error, r.lat, r.loaded])}`);
+    check(r.reloads > 0, 'the chunks of the edit made while the page was away were not reloaded');
     // the requests refused while the server was gone were the point (the browser reports them)
     const refused = /Failed to load resource|ERR_CONNECTION_REFUSED|502 \(Bad Gateway\)/;
     problems.splice(before, problems.length - before, ...problems.slice(before).filter((p) => !refused.test(p)));
