@@ -539,6 +539,30 @@ mod tests {
         v
     }
 
+    /// `chunks_near` from the point `dist` planet radii along `dir` (the centre for a tiny `dir`)
+    /// finds exactly the brute force's chunks, in its order.
+    fn same_as_brute_force(
+        planet: &Planet,
+        dir: [f64; 3],
+        dist: f64,
+        range: f64,
+        level: u8,
+    ) -> Result<(), TestCaseError> {
+        let layout = planet.layout();
+        let level = level.min(layout.max_level());
+        let d = DVec3::from_array(dir);
+        let p = if d.length() < 1e-6 {
+            DVec3::ZERO
+        } else {
+            d.normalize() * dist * layout.radius()
+        };
+        let (hits, total) = chunks_near(planet, level, p, range, usize::MAX, usize::MAX).unwrap();
+        let expected = brute_force(planet, level, p, range);
+        prop_assert_eq!(total, expected.len());
+        prop_assert_eq!(hits, expected);
+        Ok(())
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
         #[test]
@@ -551,14 +575,7 @@ mod tests {
             // Level 3 chunks reach past the shell's top (four level-0 chunks deep, eight per
             // level-3 chunk).
             let layout = Layout::new(8, 4, 100.0, 2.0, 4).unwrap();
-            let planet = Planet::new(PresetKind::Earthlike, 3, layout);
-            let level = level.min(layout.max_level());
-            let d = DVec3::from_array(dir);
-            let p = if d.length() < 1e-6 { DVec3::ZERO } else { d.normalize() * dist * layout.radius() };
-            let (hits, total) = chunks_near(&planet, level, p, range, usize::MAX, usize::MAX).unwrap();
-            let expected = brute_force(&planet, level, p, range);
-            prop_assert_eq!(total, expected.len());
-            prop_assert_eq!(hits, expected);
+            same_as_brute_force(&Planet::new(PresetKind::Earthlike, 3, layout), dir, dist, range, level)?;
         }
 
         /// A shell many chunks deep (sixteen level-0 chunks) over a small core: the search walks
@@ -574,14 +591,7 @@ mod tests {
         ) {
             let layout = Layout::new(8, 4, 60.0, 1.0, 16).unwrap();
             let kind = [PresetKind::Sphere, PresetKind::Earthlike, PresetKind::Moon][preset];
-            let planet = Planet::new(kind, 5, layout);
-            let level = level.min(layout.max_level());
-            let d = DVec3::from_array(dir);
-            let p = if d.length() < 1e-6 { DVec3::ZERO } else { d.normalize() * dist * layout.radius() };
-            let (hits, total) = chunks_near(&planet, level, p, range, usize::MAX, usize::MAX).unwrap();
-            let expected = brute_force(&planet, level, p, range);
-            prop_assert_eq!(total, expected.len());
-            prop_assert_eq!(hits, expected);
+            same_as_brute_force(&Planet::new(kind, 5, layout), dir, dist, range, level)?;
         }
     }
 
