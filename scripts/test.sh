@@ -1,8 +1,21 @@
 #!/usr/bin/env bash
 # Runs every test of the project: formatting, lints, the Rust test suite, and the external checks
 # of exported planets (Khronos glTF validator, trimesh). Installs what it needs on a fresh machine.
+#
+#   ./scripts/test.sh           every test (what CI runs)
+#   ./scripts/test.sh --quick   the inner loop: formatting, lints, the viewer's unit tests and the
+#                               Rust suite; no exports, external validators or browser tests
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+QUICK=0
+for arg in "$@"; do
+  case "$arg" in
+    --quick) QUICK=1 ;;
+    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    *) echo "test.sh: unknown option $arg (--quick, --help)" >&2; exit 2 ;;
+  esac
+done
 
 step() { printf '\n==> %s\n' "$*"; }
 
@@ -54,6 +67,13 @@ cargo test --workspace --locked 2>&1 | tee target/cargo-test.log
 # viewer/dist embedded): the exports and the end-to-end tests below use it too, so the suite
 # compiles the workspace once, not a second time for a release build.
 PMC=target/debug/pmc
+
+if [ "$QUICK" = 1 ]; then
+  step "quick mode: exports, external validators and the end-to-end tests not run"
+  VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
+  awk -v ext="${VITEST:-0}" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/cargo-test.log
+  exit 0
+fi
 
 OUT=target/test-artifacts
 mkdir -p "$OUT"
