@@ -49,6 +49,7 @@ import * as planetDrawn from './scenarios/planetDrawn.mjs';
 import * as presetSwitch from './scenarios/presetSwitch.mjs';
 import * as seaByData from './scenarios/seaByData.mjs';
 import * as sky from './scenarios/sky.mjs';
+import * as soak from './scenarios/soak.mjs';
 import * as viewsAndModes from './scenarios/viewsAndModes.mjs';
 import { startBackend } from './servers.mjs';
 
@@ -61,7 +62,7 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
  */
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
 /** Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API). */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel, sky, imagery, levelSwitch, seaByData, overlays];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel, sky, imagery, levelSwitch, seaByData, overlays, soak];
 
 async function main() {
   if (!existsSync(join(distDir, 'index.html'))) throw new Error('viewer/dist is missing: run `npm run build` first');

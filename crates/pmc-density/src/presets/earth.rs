@@ -46,14 +46,16 @@
 //! next eight entries that count at once ([`crate::noise::gradient3_x8`]): the same bits as one
 //! at a time.
 
+use super::features::model_key;
 use super::features::{lerp, radial, smoothstep, CaveBand, Scales, Spaghetti, Stretch};
 use super::layouts::EARTH_RADIUS;
 use super::shading::{Look, MaterialMap};
+use super::EdgeVertices;
 use super::{PresetKind, Terrain};
 use crate::noise::{
     derive_seed, gradient3, gradient3_x8, mix64, unit_f64, Fbm, FbmParams, Lanes8, DEFAULT_LACUNARITY, LANES,
 };
-use crate::Density;
+use crate::{Density, ShellColumns};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;
 use std::sync::Arc;
@@ -176,6 +178,8 @@ pub(crate) struct EarthColumn {
     /// 3D rock and cliff amplitudes (metres).
     a_rock: f64,
     a_cliff: f64,
+    /// The mountain mask in `[0, 1]` (the shader's rock above the tree line).
+    mountains: f64,
     /// Cave gate in `[0, 1]` and roof depth (metres, negative where the roof opens).
     cave_gate: f64,
     roof: f64,
@@ -459,6 +463,7 @@ impl EarthModel {
         let margin = self.s.l_d + 1e-6 * self.s.thickness;
         let mut col = EarthColumn {
             factor,
+            mountains,
             a_rock,
             a_cliff,
             cave_gate,
@@ -577,6 +582,37 @@ impl EarthModel {
         col.height()
     }
 
+    /// Refines `col` while some sample of a batch at radii `rs` may still need it. Refining
+    /// further than a sample needs never changes its value (its stopping entry depends on the
+    /// sample alone), so the column stops as soon as no sample lies inside its (nested,
+    /// shrinking) interval: a chunk whose layers are far apart stops long before the ladder's
+    /// end. `sorted`: `rs` is in increasing order with none negative; the samples still refining
+    /// then form one run of them.
+    fn refine_batch(&self, col: &mut EarthColumn, dir: DVec3, rs: &[f64], sorted: bool) {
+        if sorted {
+            let (mut a, mut b) = (0, rs.len());
+            while col.done < self.entries.len() {
+                let k = col.done;
+                while a < b && rs[a] <= col.keep_lo[k] {
+                    a += 1;
+                }
+                while a < b && rs[b - 1] >= col.keep_hi[k] {
+                    b -= 1;
+                }
+                if a == b {
+                    break;
+                }
+                self.advance(col, dir);
+            }
+        } else {
+            let r_min = rs.iter().copied().fold(f64::INFINITY, f64::min);
+            let r_max = rs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            while col.done < self.entries.len() && col.keep_lo[col.done] < r_max && r_min < col.keep_hi[col.done] {
+                self.advance(col, dir);
+            }
+        }
+    }
+
     /// The density at radius `r` of a column refined at least as far as `r` needs.
     #[inline]
     fn value(&self, col: &EarthColumn, dir: DVec3, r: f64) -> f64 {
@@ -600,6 +636,38 @@ impl EarthModel {
             }
         }
         col.h[lo] - r
+    }
+
+    /// [`EarthModel::value`] at every radius of `rs` (in increasing order), handed to `put`
+    /// with its index, in time proportional to the samples and the ladder, not to the samples
+    /// times the ladder's logarithm: a sample stops at the first entry `k` whose interval does
+    /// not hold it, the first with `keep_lo[k] >= r` or with `keep_hi[k] <= r`; the intervals are
+    /// nested, so the first of these moves only up and the second only down as `r` grows.
+    #[inline]
+    fn values_sorted(&self, col: &EarthColumn, dir: DVec3, rs: &[f64], mut put: impl FnMut(usize, f64)) {
+        let n = col.done;
+        // below: the first k with keep_lo[k] >= r (n + 1: none); above: the first k with
+        // keep_hi[k] <= r.
+        let mut below = 0;
+        let mut above = n + 1;
+        for (i, r) in rs.iter().enumerate() {
+            let r = *r;
+            while below <= n && col.keep_lo[below] < r {
+                below += 1;
+            }
+            while above > 0 && col.keep_hi[above - 1] <= r {
+                above -= 1;
+            }
+            let stop = below.min(above);
+            let v = if stop <= n {
+                col.h[stop] - r
+            } else {
+                debug_assert_eq!(n, self.entries.len());
+                self.near_surface(col, dir, col.h[n], r)
+            };
+            debug_assert_eq!(v.to_bits(), self.value(col, dir, r).to_bits());
+            put(i, v);
+        }
     }
 
     /// The full formula near the surface: the height field displaced by rocks and cliffs, carved
@@ -695,6 +763,53 @@ fn ladder(seed: u64, ratio: f64, tile: f64) -> Vec<Entry> {
 /// The earth density: the model behind the [`Density`] trait, with the band-limited batch.
 pub(crate) struct EarthDensity(pub Arc<EarthModel>);
 
+impl EarthDensity {
+    /// The density of `model`, with an empty column cache.
+    pub(crate) fn new(model: Arc<EarthModel>) -> Self {
+        EarthDensity(model)
+    }
+
+    /// The batch of [`Density::sample_shell`], leaving in `kept` (when given; cleared first)
+    /// every column it used, refined as far as the layers needed, in the order of `dirs`.
+    fn batch(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], mut kept: Option<&mut Vec<EarthColumn>>) {
+        assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
+        let m = &*self.0;
+        let n = dirs.len();
+        // The point call sees `|dir * r|`; the batch takes the same radius so both follow the
+        // same path (they differ only by the rounding of the direction).
+        let mut rs = vec![0.0; radii.len()];
+        // Layer radii come in increasing order from every chunk grid; `|dir * r|` keeps that
+        // order (each rounded operation is monotone), so the samples still refining form one
+        // run of them.
+        let sorted = radii.windows(2).all(|w| w[0] <= w[1]) && radii.first().is_none_or(|r| *r >= 0.0);
+        if let Some(k) = kept.as_deref_mut() {
+            k.clear();
+            k.reserve(n);
+        }
+        let mut scratch = None;
+        for (d, dir) in dirs.iter().enumerate() {
+            for (x, r) in rs.iter_mut().zip(radii) {
+                *x = (*dir * *r).length();
+            }
+            let col = match kept.as_deref_mut() {
+                Some(k) => {
+                    k.push(m.column(*dir));
+                    k.last_mut().expect("just pushed")
+                }
+                None => scratch.insert(m.column(*dir)),
+            };
+            m.refine_batch(col, *dir, &rs, sorted);
+            if sorted {
+                m.values_sorted(col, *dir, &rs, |k, v| out[k * n + d] = v as f32);
+            } else {
+                for (k, r) in rs.iter().enumerate() {
+                    out[k * n + d] = m.value(col, *dir, *r) as f32;
+                }
+            }
+        }
+    }
+}
+
 impl Density for EarthDensity {
     /// The columns' heights refined until the octaves left amount to at most half a percent of
     /// `detail` (at least a metre): a height for features of about `detail` metres.
@@ -719,51 +834,16 @@ impl Density for EarthDensity {
     }
 
     fn sample_shell(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32]) {
-        assert_eq!(out.len(), dirs.len() * radii.len(), "output buffer has the wrong size");
-        let m = &*self.0;
-        let n = dirs.len();
-        // The point call sees `|dir * r|`; the batch takes the same radius so both follow the
-        // same path (they differ only by the rounding of the direction).
-        let mut rs = vec![0.0; radii.len()];
-        // Layer radii come in increasing order from every chunk grid; `|dir * r|` keeps that
-        // order (each rounded operation is monotone), so the samples still refining form one
-        // run of them.
-        let sorted = radii.windows(2).all(|w| w[0] <= w[1]) && radii.first().is_none_or(|r| *r >= 0.0);
-        for (d, dir) in dirs.iter().enumerate() {
-            for (x, r) in rs.iter_mut().zip(radii) {
-                *x = (*dir * *r).length();
-            }
-            let mut col = m.column(*dir);
-            // Refine while some sample may still need it. Refining further than a sample needs
-            // never changes its value (its stopping entry depends on the sample alone), so the
-            // column stops as soon as no sample lies inside its (nested, shrinking) interval:
-            // a chunk whose layers are far apart stops long before the ladder's end.
-            if sorted {
-                let (mut a, mut b) = (0, rs.len());
-                while col.done < m.entries.len() {
-                    let k = col.done;
-                    while a < b && rs[a] <= col.keep_lo[k] {
-                        a += 1;
-                    }
-                    while a < b && rs[b - 1] >= col.keep_hi[k] {
-                        b -= 1;
-                    }
-                    if a == b {
-                        break;
-                    }
-                    m.advance(&mut col, *dir);
-                }
-            } else {
-                let r_min = rs.iter().copied().fold(f64::INFINITY, f64::min);
-                let r_max = rs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                while col.done < m.entries.len() && col.keep_lo[col.done] < r_max && r_min < col.keep_hi[col.done] {
-                    m.advance(&mut col, *dir);
-                }
-            }
-            for (k, r) in rs.iter().enumerate() {
-                out[k * n + d] = m.value(&col, *dir, *r) as f32;
-            }
-        }
+        self.batch(dirs, radii, out, None);
+    }
+
+    /// The batch, keeping its columns (`Vec<EarthColumn>`, one per direction, each refined
+    /// as far as the batch's layers needed) for the shader ([`EarthMaterials`]).
+    fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
+        let owner = model_key(&self.0);
+        columns.keep(owner, dirs, |kept: &mut Vec<EarthColumn>| {
+            self.batch(dirs, radii, out, Some(kept))
+        });
     }
 
     fn radial_bounds(&self) -> Option<(f64, f64)> {
@@ -818,17 +898,81 @@ impl EarthMaterials {
     }
 }
 
-impl MaterialMap for EarthMaterials {
-    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+/// What the earth's materials read of a column: the mountain mask, the 3D terms' amplitudes and
+/// the cave gate (from [`EarthModel::surface_fields`] at a point, from the columns of a vertex's
+/// edge in a chunk).
+#[derive(Clone, Copy)]
+struct ColumnFields {
+    mountains: f64,
+    a_rock: f64,
+    a_cliff: f64,
+    cave_gate: f64,
+}
+
+impl ColumnFields {
+    fn of(col: &EarthColumn) -> Self {
+        ColumnFields {
+            mountains: col.mountains,
+            a_rock: col.a_rock,
+            a_cliff: col.a_cliff,
+            cave_gate: col.cave_gate,
+        }
+    }
+
+    fn lerp(&self, o: &Self, t: f64) -> Self {
+        ColumnFields {
+            mountains: lerp(self.mountains, o.mountains, t),
+            a_rock: lerp(self.a_rock, o.a_rock, t),
+            a_cliff: lerp(self.a_cliff, o.a_cliff, t),
+            cave_gate: lerp(self.cave_gate, o.cave_gate, t),
+        }
+    }
+}
+
+impl EarthModel {
+    /// Whether `lerp(h_a, h_b, t) - r > depth` for the full heights of columns `a` and `b`
+    /// (along `dir_a`, `dir_b`; `b` may be `a` itself with `t = 0`), refining copies of them only
+    /// until the sound bounds on their remaining octaves settle the comparison: the same answer
+    /// whatever they were refined to before.
+    fn lerp_deeper_than(&self, a: (&EarthColumn, DVec3), b: (&EarthColumn, DVec3), t: f64, r: f64, depth: f64) -> bool {
+        let len = self.entries.len();
+        let (mut ca, mut cb) = (std::borrow::Cow::Borrowed(a.0), std::borrow::Cow::Borrowed(b.0));
+        loop {
+            let (ka, kb) = (ca.done, cb.done);
+            let h = lerp(ca.h[ka], cb.h[kb], t);
+            let rem = lerp(ca.rem[ka], cb.rem[kb], t);
+            // Refine the column whose bound weighs most (of those that can go on and count).
+            let wa = if ka < len && t < 1.0 {
+                (1.0 - t) * ca.rem[ka]
+            } else {
+                -1.0
+            };
+            let wb = if kb < len && t > 0.0 { t * cb.rem[kb] } else { -1.0 };
+            if (h - r - depth).abs() > rem || (wa < 0.0 && wb < 0.0) {
+                return h - r > depth;
+            }
+            if wa >= wb {
+                self.advance(ca.to_mut(), a.1);
+            } else {
+                self.advance(cb.to_mut(), b.1);
+            }
+        }
+    }
+}
+
+impl EarthMaterials {
+    /// The material at `p` (normal `normal`) with the column fields `f` there; `deeper` tells
+    /// whether `p` lies more than the given depth under the height field (asked only where caves
+    /// can be).
+    fn material_with(&self, p: DVec3, normal: DVec3, f: &ColumnFields, deeper: impl FnOnce(f64) -> bool) -> u8 {
         let m = &*self.model;
         let (l_d, tile, v) = (m.s.l_d, m.s.tile, m.vert);
         let (r, dir) = radial(p);
-        let f = m.surface_fields(dir, m.continent(dir));
         // Cave rock: well under the height field. Rock bumps and cliffs move the surface by at
         // most `a_rock + a_cliff`, less than the threshold, so only carved caves get there:
         // columns without caves need no height at all.
         let cave_depth = (1.5 * l_d).max(f.a_rock + f.a_cliff + l_d);
-        if f.cave_gate > 0.0 && m.deeper_than(&mut m.column(dir), dir, r, cave_depth) {
+        if f.cave_gate > 0.0 && deeper(cave_depth) {
             return CAVE;
         }
         // Heights above the sea: in layout metres for the shore, in true-scale metres for the
@@ -870,11 +1014,64 @@ impl MaterialMap for EarthMaterials {
     }
 }
 
+impl MaterialMap for EarthMaterials {
+    fn material(&self, p: DVec3, normal: DVec3) -> u8 {
+        let m = &*self.model;
+        let (r, dir) = radial(p);
+        let s = m.surface_fields(dir, m.continent(dir));
+        let f = ColumnFields {
+            mountains: s.mountains,
+            a_rock: s.a_rock,
+            a_cliff: s.a_cliff,
+            cave_gate: s.cave_gate,
+        };
+        self.material_with(p, normal, &f, |depth| m.deeper_than(&mut m.column(dir), dir, r, depth))
+    }
+
+    /// A chunk's vertices take the column fields and heights of their edge's ends (interpolated
+    /// along lateral edges), from the columns the density batch kept: a vertex costs a few noise
+    /// values instead of a column of its own, whose cave test alone ran most of the ladder.
+    fn edge_materials(&self, v: &EdgeVertices<'_>, out: &mut Vec<u8>) {
+        let m = &*self.model;
+        let kept = v.columns.get::<EarthColumn>(model_key(&self.model), v.dirs);
+        // Without kept columns, each direction an edge ends at is computed once.
+        let mut computed: Vec<Option<EarthColumn>> = Vec::new();
+        if kept.is_none() {
+            computed.resize(v.dirs.len(), None);
+            for e in v.edges {
+                for d in [e.a as usize, e.b as usize] {
+                    if computed[d].is_none() {
+                        computed[d] = Some(m.column(v.dirs[d]));
+                    }
+                }
+            }
+        }
+        let col = |d: u32| -> Option<&EarthColumn> {
+            match kept {
+                Some(k) => k.get(d as usize),
+                None => computed.get(d as usize)?.as_ref(),
+            }
+        };
+        out.clear();
+        out.extend(v.points.iter().zip(v.normals).zip(v.edges).map(|((p, normal), e)| {
+            let (Some(ca), Some(cb)) = (col(e.a), col(e.b)) else {
+                // (not reached: `check` bounds the edges, and every end was computed)
+                return self.material(*p, *normal);
+            };
+            let (a, b) = ((ca, v.dirs[e.a as usize]), (cb, v.dirs[e.b as usize]));
+            let t = if e.a == e.b { 0.0 } else { e.t };
+            let f = ColumnFields::of(ca).lerp(&ColumnFields::of(cb), t);
+            let r = p.length();
+            self.material_with(*p, *normal, &f, |depth| m.lerp_deeper_than(a, b, t, r, depth))
+        }));
+    }
+}
+
 /// Builds the earth terrain.
 pub(crate) fn build(seed: u64, layout: &Layout) -> Terrain {
     let model = Arc::new(EarthModel::new(seed, layout));
     let (sea, tile) = (model.sea(), model.s.tile);
-    let density = Arc::new(EarthDensity(model.clone()));
+    let density = Arc::new(EarthDensity::new(model.clone()));
     let spec = crate::terrain::TerrainSpec::preset(PresetKind::Earth, seed);
     LOOK.terrain(spec, density, Some(sea), EarthMaterials::new(model, seed), tile)
 }
@@ -887,7 +1084,7 @@ mod tests {
     fn earth(seed: u64) -> (Layout, Arc<EarthModel>, EarthDensity) {
         let layout = PresetKind::Earth.default_layout(None).unwrap();
         let m = Arc::new(EarthModel::new(seed, &layout));
-        (layout, m.clone(), EarthDensity(m))
+        (layout, m.clone(), EarthDensity::new(m))
     }
 
     /// The column along `dir` with every ladder entry evaluated, and its height.
@@ -1309,6 +1506,133 @@ mod tests {
             }
         }
         assert!(caves > 100 && plain > 100, "{caves} cave, {plain} other");
+    }
+
+    #[test]
+    fn edge_vertices_are_cave_rock_by_the_full_heights_of_their_ends() {
+        // A chunk's vertex is cave rock when it lies deeper than the cave depth under the height
+        // interpolated between its edge's ends, whatever those columns were refined to by the
+        // batch (refined copies settle the comparison): the answer of the full ladders.
+        let (_, m, _) = earth(7);
+        let dirs = sphere_dirs(2000);
+        let (mut caves, mut plain) = (0, 0);
+        for (i, pair) in dirs.windows(2).enumerate() {
+            let (da, db) = (pair[0], pair[1]);
+            let ((fa, ha), (fb, hb)) = (full(&m, da), full(&m, db));
+            if ha.min(hb) < m.sea + 20.0 {
+                continue;
+            }
+            // Columns refined to different depths, as batches leave them.
+            let mut ca = m.column(da);
+            for _ in 0..(i % 9) * 3 {
+                m.advance(&mut ca, da);
+            }
+            let cb = m.column(db);
+            for t in [0.0, 0.25, 0.5, 1.0] {
+                let h = lerp(ha, hb, t);
+                let depth = 3.0 + 10.0 * t;
+                for dz in [-40.0, -depth - 0.01, -depth + 0.01, -1.0, 0.0, 3.0] {
+                    let r = h + dz;
+                    let deeper = m.lerp_deeper_than((&ca, da), (&cb, db), t, r, depth);
+                    assert_eq!(deeper, h - r > depth, "t {t}, dz {dz}");
+                    // The same with the full columns given.
+                    assert_eq!(deeper, m.lerp_deeper_than((&fa, da), (&fb, db), t, r, depth));
+                    if deeper {
+                        caves += 1;
+                    } else {
+                        plain += 1;
+                    }
+                }
+            }
+        }
+        assert!(caves > 100 && plain > 100, "{caves} deeper, {plain} not");
+    }
+
+    #[test]
+    fn edge_vertices_shade_alike_with_and_without_the_batch_columns() {
+        // The shader reads the columns the chunk's batch kept (refined as far as its layers
+        // needed); computed afresh they give the same shades, and a radial edge's vertex takes
+        // its column's fields and the cave test of its full height.
+        use crate::presets::EdgeVertices;
+        use crate::ShellColumns;
+        use pmc_geometry::VertexEdge;
+        let (layout, m, d) = earth(7);
+        let ter = build(7, &layout);
+        let base = sphere_dirs(400)
+            .into_iter()
+            .find(|dir| full(&m, *dir).1 > m.sea + 500.0 && m.column(*dir).cave_gate > 0.0)
+            .expect("a land column with caves");
+        let step = 2.0 * m.s.l_d / m.sea;
+        let (u, w) = base.any_orthonormal_pair();
+        let dirs: Vec<DVec3> = (0..64)
+            .map(|i| (base + u * (step * f64::from(i % 8)) + w * (step * f64::from(i / 8))).normalize())
+            .collect();
+        let heights: Vec<f64> = dirs.iter().map(|dir| full(&m, *dir).1).collect();
+        let edges: Vec<VertexEdge> = (0..64u32)
+            .flat_map(|i| {
+                [
+                    VertexEdge { a: i, b: i, t: 0.0 },
+                    VertexEdge {
+                        a: i,
+                        b: (i + 1) % 64,
+                        t: f64::from(i % 5) / 4.0,
+                    },
+                ]
+            })
+            .collect();
+        let points: Vec<DVec3> = edges
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                let (a, b) = (dirs[e.a as usize], dirs[e.b as usize]);
+                let h = lerp(heights[e.a as usize], heights[e.b as usize], e.t);
+                let dz = [0.0, -2.0 * m.s.l_d, -30.0 * m.s.l_d, 0.5][k % 4];
+                (a + (b - a) * e.t).normalize() * (h + dz)
+            })
+            .collect();
+        let normals: Vec<DVec3> = points.iter().map(|p| p.normalize()).collect();
+        // The layers of a chunk around the surface.
+        let h0 = heights[0];
+        let radii: Vec<f64> = (0..35).map(|k| h0 - 20.0 + f64::from(k) * m.s.l_d).collect();
+        let mut kept = ShellColumns::default();
+        let mut out = vec![0.0f32; dirs.len() * radii.len()];
+        d.sample_shell_keeping(&dirs, &radii, &mut out, &mut kept);
+        assert!(!kept.is_empty(), "the earth batch keeps its columns");
+        let mut plain = vec![0.0f32; out.len()];
+        d.sample_shell(&dirs, &radii, &mut plain);
+        assert_eq!(
+            out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            plain.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "keeping the columns changes no sample"
+        );
+        let shade = |columns: &ShellColumns| {
+            let v = EdgeVertices {
+                points: &points,
+                normals: &normals,
+                edges: &edges,
+                dirs: &dirs,
+                columns,
+            };
+            let mut shades = Vec::new();
+            ter.shader.shade_edges(&v, &mut shades);
+            shades
+        };
+        let from_batch = shade(&kept);
+        assert_eq!(from_batch, shade(&ShellColumns::default()));
+        let caves = from_batch.iter().filter(|s| s.material == CAVE).count();
+        assert!(caves > 0 && caves < from_batch.len(), "{caves} cave vertices");
+        // Radial edges: cave rock exactly where the point is deeper than the cave depth under its
+        // column's full height.
+        for (k, (e, s)) in edges.iter().zip(&from_batch).enumerate() {
+            if e.a != e.b {
+                continue;
+            }
+            let c = m.column(dirs[e.a as usize]);
+            let depth = (1.5 * m.s.l_d).max(c.a_rock + c.a_cliff + m.s.l_d);
+            let r = points[k].length();
+            let deep = c.cave_gate > 0.0 && heights[e.a as usize] - r > depth;
+            assert_eq!(s.material == CAVE, deep, "vertex {k}");
+        }
     }
 
     #[test]
