@@ -73,7 +73,14 @@ export async function openBrowser() {
   const hook = hookOn(page);
   const readyOn = async (p, what) => {
     const t0 = Date.now();
-    await hookOn(p)((ms) => window.__pmc.ready(ms), READY_MS);
+    try {
+      await hookOn(p)((ms) => window.__pmc.ready(ms), READY_MS);
+    } catch (e) {
+      // a view that does not converge: say what the streaming was doing (pending, missing, blocked
+      // by a failure's back-off, timed out) for the report
+      const s = await hookOn(p)(() => window.__pmc.stats()).catch((err) => `(no stats: ${err.message})`);
+      throw new Error(`${what}: ${e.message}; streaming ${JSON.stringify(s).slice(0, 1500)}`);
+    }
     const s = await hookOn(p)(() => window.__pmc.stats());
     log(`  ready ${what}: ${s.loaded} chunks, ${s.triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s`);
     return s;

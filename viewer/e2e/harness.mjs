@@ -107,8 +107,12 @@ export const results = [];
 const ONLY = process.env.PMC_E2E_ONLY ? new Set(process.env.PMC_E2E_ONLY.split(',').map((x) => x.trim())) : null;
 /** Whether step 16, the README's gallery, runs (PMC_E2E_GALLERY=1, or PMC_E2E_ONLY naming it). */
 export const GALLERY = process.env.PMC_E2E_GALLERY === '1' || (ONLY?.has('16') ?? false);
+/** Whether the step named `name` runs (PMC_E2E_ONLY). */
+export function selected(name) {
+  return !ONLY || ONLY.has(name.split('.')[0]);
+}
 export async function step(name, fn) {
-  if (ONLY && !ONLY.has(name.split('.')[0])) return;
+  if (!selected(name)) return;
   const t0 = Date.now();
   log(`▶ ${name}`);
   try {

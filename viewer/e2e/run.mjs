@@ -20,6 +20,9 @@
 //                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
+//   PMC_E2E_LANES=1 one step after the other (by default steps 10, 11, 14 and 15, over true-scale
+//                   planets, run in a second browser beside the others; the soak, step 18, runs
+//                   last and alone)
 //
 // The harness is harness.mjs (settings, log, clean-ups, steps), servers.mjs (pmc serve, the front
 // server, the mock) and browser.mjs (Chromium, its page and the helpers the steps use); each step
@@ -32,7 +35,7 @@
 import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { openBrowser } from './browser.mjs';
-import { CHROMIUM, GALLERY, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, short, started, step } from './harness.mjs';
+import { CHROMIUM, GALLERY, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, selected, short, started, step } from './harness.mjs';
 import * as closeup from './scenarios/closeup.mjs';
 import * as editing from './scenarios/editing.mjs';
 import * as elevationModel from './scenarios/elevationModel.mjs';
@@ -62,7 +65,15 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
  */
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
 /** Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API). */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, lodEarth, elevationModel, sky, imagery, levelSwitch, seaByData, overlays, soak];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, sky, imagery, overlays];
+/**
+ * The steps over true-scale planets (the earth preset, an elevation model), each with servers of
+ * its own: run in a second browser beside the others (PMC_E2E_LANES, by default 2).
+ */
+const SECOND_LANE = [lodEarth, elevationModel, levelSwitch, seaByData];
+/** Then, alone on the machine (it compares the times of its views): the soak. */
+const LAST = [soak];
+const LANES = Number(process.env.PMC_E2E_LANES ?? 2);
 
 async function main() {
   if (!existsSync(join(distDir, 'index.html'))) throw new Error('viewer/dist is missing: run `npm run build` first');
@@ -79,14 +90,27 @@ async function main() {
      */
     shared: { pageBase, orbitStats: null, orbitImg: null, closeup: null },
   };
-  for (const s of SCENARIOS) await step(s.name, () => s.scenario(t));
-
-  if (USE_MOCK) {
-    log('8. and 7. need the real `pmc serve` (the mock has no /path, /navgrid or editing API): not run with PMC_E2E_MOCK=1');
-    return;
+  const firstLane = async () => {
+    for (const s of SCENARIOS) await step(s.name, () => s.scenario(t));
+    if (USE_MOCK) {
+      log('8. and 7. need the real `pmc serve` (the mock has no /path, /navgrid or editing API): not run with PMC_E2E_MOCK=1');
+      return;
+    }
+    for (const s of REAL_SERVER_SCENARIOS) await step(s.name, () => s.scenario(t));
+  };
+  const secondLane = async (on) => {
+    if (USE_MOCK) return;
+    for (const s of SECOND_LANE) await step(s.name, () => s.scenario(on));
+  };
+  if (LANES >= 2 && !USE_MOCK && SECOND_LANE.some((s) => selected(s.name))) {
+    // a browser of its own: its page, console and requests are the second lane's
+    const other = { ...(await openBrowser()), shared: t.shared };
+    await Promise.all([firstLane(), secondLane(other)]);
+  } else {
+    await firstLane();
+    await secondLane(t);
   }
-
-  for (const s of REAL_SERVER_SCENARIOS) await step(s.name, () => s.scenario(t));
+  if (!USE_MOCK) for (const s of LAST) await step(s.name, () => s.scenario(t));
   // the README's pictures: asked for (PMC_E2E_GALLERY=1, or PMC_E2E_ONLY naming step 16)
   if (GALLERY) await step(gallery.name, () => gallery.scenario(t));
 }

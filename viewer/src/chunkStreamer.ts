@@ -41,6 +41,12 @@ export interface StreamerOptions {
   maxLoaded?: number;
   /** Bytes of loaded chunks kept at most (same rule; default 256 MiB). */
   maxBytes?: number;
+  /**
+   * A request unanswered for this long (milliseconds; default 60 000) is aborted and tried again
+   * after the back-off: a request the server or the network never answers must not hold one of
+   * the few slots for good, or the chunks behind it are never asked for (a stalled view).
+   */
+  requestTimeoutMs?: number;
   now?: () => number;
 }
 
@@ -58,6 +64,8 @@ interface Pending {
   /** A refetch of an edited chunk that stays on screen until the new data arrives. */
   reload: boolean;
   priority: number;
+  /** When it was sent (`now()`). */
+  sent: number;
 }
 
 interface Loaded {
@@ -98,6 +106,10 @@ export interface StreamerStats {
   aborted: number;
   failed: number;
   evicted: number;
+  /** Requests given up after `requestTimeoutMs` without an answer (counted in `failed` too). */
+  timedOut: number;
+  /** Wanted chunks neither loaded nor pending that wait for the back-off of a failure. */
+  blocked: number;
   /** Shown chunks waiting to be fetched again (edited), and refetches under way. */
   stale: number;
   reloading: number;
@@ -149,11 +161,12 @@ export class ChunkStreamer {
   private complete = false;
   private holes = new Set<string>();
   private bytes = 0;
-  private counts = { requested: 0, aborted: 0, failed: 0, evicted: 0, reloads: 0, selections: 0 };
+  private counts = { requested: 0, aborted: 0, failed: 0, evicted: 0, reloads: 0, selections: 0, timedOut: 0 };
   private hadError = false;
   private readonly maxConcurrent: number;
   private readonly maxLoaded: number;
   private readonly maxBytes: number;
+  private readonly requestTimeoutMs: number;
   private readonly now: () => number;
 
   constructor(
@@ -164,6 +177,7 @@ export class ChunkStreamer {
     this.maxConcurrent = opts.maxConcurrent ?? DEFAULT_MAX_CONCURRENT;
     this.maxLoaded = opts.maxLoaded ?? 6000;
     this.maxBytes = opts.maxBytes ?? 256 * 1024 * 1024;
+    this.requestTimeoutMs = opts.requestTimeoutMs ?? 60_000;
     this.now = opts.now ?? (() => performance.now());
   }
 
@@ -215,7 +229,7 @@ export class ChunkStreamer {
     this.holes = new Set();
     this.bytes = 0;
     this.serial = 0;
-    this.counts = { requested: 0, aborted: 0, failed: 0, evicted: 0, reloads: 0, selections: 0 };
+    this.counts = { requested: 0, aborted: 0, failed: 0, evicted: 0, reloads: 0, selections: 0, timedOut: 0 };
     this.planet = { ...planet };
     this.lod = lod;
   }
@@ -331,6 +345,7 @@ export class ChunkStreamer {
   private pump(): void {
     if (this.lod === null || this.paused) return;
     const now = this.now();
+    this.expire(now);
     const free = (): boolean => this.pending.size < this.maxConcurrent;
     // refetches of edited chunks come first: the user is looking at them
     for (const id of [...this.stale]) {
@@ -351,6 +366,25 @@ export class ChunkStreamer {
       const next = g === undefined || (w !== undefined && byPriority(w, g) <= 0) ? (a++, w!) : (b++, g);
       if (this.cache.has(next.id) || this.pending.has(next.id) || this.blocked(next.id, now)) continue;
       this.request(next.id, next.name, next.seams, next.priority, false);
+    }
+  }
+
+  /**
+   * Gives up the requests unanswered for `requestTimeoutMs`: each is aborted and counted as a
+   * failure (retried after the back-off), so its slot goes to the next chunk.
+   */
+  private expire(now: number): void {
+    for (const [id, p] of this.pending) {
+      if (now - p.sent < this.requestTimeoutMs) continue;
+      this.pending.delete(id);
+      p.abort.abort();
+      this.counts.failed++;
+      this.counts.timedOut++;
+      const count = (this.failures.get(id)?.count ?? 0) + 1;
+      this.failures.set(id, { count, retryAt: now + retryDelay(null, count) });
+      // a refetch of a chunk still shown is tried again (after the back-off)
+      if ((this.refetch.delete(id) || p.reload) && this.shown.get(p.name) === p.seams) this.stale.add(id);
+      if (count >= 3) this.reportError(`chunk ${p.name}: no answer within ${Math.round(this.requestTimeoutMs / 1000)} s, ${count} times`);
     }
   }
 
@@ -477,7 +511,7 @@ export class ChunkStreamer {
   private request(id: string, name: string, seams: number, priority: number, reload: boolean): void {
     const generation = this.generation;
     const abort = new AbortController();
-    this.pending.set(id, { name, seams, abort, reload, priority });
+    this.pending.set(id, { name, seams, abort, reload, priority, sent: this.now() });
     this.counts.requested++;
     if (reload) this.counts.reloads++;
     this.api
@@ -623,7 +657,13 @@ export class ChunkStreamer {
     let reloading = 0;
     for (const p of this.pending.values()) if (p.reload) reloading++;
     let missing = 0;
-    for (const w of this.wanted) if (!this.cache.has(w.id) && !this.pending.has(w.id)) missing++;
+    let blocked = 0;
+    const now = this.now();
+    for (const w of this.wanted) {
+      if (this.cache.has(w.id) || this.pending.has(w.id)) continue;
+      missing++;
+      if (this.blocked(w.id, now)) blocked++;
+    }
     return {
       loaded: this.cache.size,
       pending: this.pending.size,
@@ -642,6 +682,8 @@ export class ChunkStreamer {
       aborted: this.counts.aborted,
       failed: this.counts.failed,
       evicted: this.counts.evicted,
+      timedOut: this.counts.timedOut,
+      blocked,
       stale: this.stale.size,
       reloading,
       reloads: this.counts.reloads,

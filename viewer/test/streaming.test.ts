@@ -161,6 +161,57 @@ describe('ChunkStreamer: what is fetched', () => {
     expect(errors).toEqual([]);
   });
 
+  it('gives up a request the server never answers, so the chunks behind it are asked for (a stalled view)', async () => {
+    // A slot held for good by a request that is never answered (a server or connection that
+    // hangs) stopped every chunk behind it: with one slot, nothing else was ever asked.
+    const server = chunkServer();
+    let clock = 0;
+    const { s, shown, errors, step } = streamerOn(server, { maxConcurrent: 1, requestTimeoutMs: 60_000, now: () => clock });
+    s.setSelection(selection(), VIEW);
+    await step();
+    const first = server.held();
+    expect(first.length).toBe(1);
+    clock = 59_999;
+    await step();
+    expect(server.held()).toEqual(first);
+    clock = 60_000;
+    await step();
+    // the hung request is aborted and the next chunk asked for
+    expect(server.aborted).toEqual(first);
+    expect(server.held().length).toBe(1);
+    expect(server.held()).not.toEqual(first);
+    expect(s.stats()).toMatchObject({ timedOut: 1, failed: 1, blocked: 1 });
+    // the others answer; the given-up one is asked again after its back-off, and the view settles
+    for (let n = 0; n < 20 && !s.settled(); n++) {
+      clock += 1000;
+      await server.releaseAll();
+      await step();
+    }
+    expect(s.settled()).toBe(true);
+    expect(server.requests.filter((r) => `${r.name}~${r.seams}` === first[0]).length).toBe(2);
+    expect(shown.size).toBe(6);
+    expect(errors).toEqual([]);
+    expect(s.stats()).toMatchObject({ timedOut: 1, blocked: 0, missing: 0 });
+  });
+
+  it('reports a chunk whose requests go unanswered three times', async () => {
+    const server = chunkServer();
+    let clock = 0;
+    const { s, errors, step } = streamerOn(server, { maxConcurrent: 6, requestTimeoutMs: 1000, now: () => clock });
+    s.setSelection(selection(), VIEW);
+    await step();
+    for (let n = 0; n < 3; n++) {
+      // nothing answers; each round gives every request up and, after the back-off, asks again
+      clock += 1000;
+      await step();
+      clock += 5000;
+      await step();
+    }
+    expect(s.stats().timedOut).toBeGreaterThanOrEqual(18);
+    expect(errors.length).toBeGreaterThan(0);
+    expect(errors[0]).toMatch(/^chunk \S+: no answer within 1 s, 3 times$/);
+  });
+
   it('counts an empty chunk as loaded', async () => {
     const server = chunkServer();
     const { s, shown, step } = streamerOn(server);

@@ -761,12 +761,12 @@ fn ladder(seed: u64, ratio: f64, tile: f64) -> Vec<Entry> {
 }
 
 /// The earth density: the model behind the [`Density`] trait, with the band-limited batch.
-pub(crate) struct EarthDensity(pub Arc<EarthModel>);
+pub(crate) struct EarthDensity(pub Arc<EarthModel>, ColumnCache);
 
 impl EarthDensity {
     /// The density of `model`, with an empty column cache.
     pub(crate) fn new(model: Arc<EarthModel>) -> Self {
-        EarthDensity(model)
+        EarthDensity(model, ColumnCache::default())
     }
 
     /// The batch of [`Density::sample_shell`], leaving in `kept` (when given; cleared first)
@@ -791,14 +791,20 @@ impl EarthDensity {
             for (x, r) in rs.iter_mut().zip(radii) {
                 *x = (*dir * *r).length();
             }
+            let found = self.1.get(*dir);
+            let done = found.as_ref().map(|c| c.done);
+            let start = found.unwrap_or_else(|| m.column(*dir));
             let col = match kept.as_deref_mut() {
                 Some(k) => {
-                    k.push(m.column(*dir));
+                    k.push(start);
                     k.last_mut().expect("just pushed")
                 }
-                None => scratch.insert(m.column(*dir)),
+                None => scratch.insert(start),
             };
             m.refine_batch(col, *dir, &rs, sorted);
+            if done.is_none_or(|d| d < col.done) {
+                self.1.put(*dir, col);
+            }
             if sorted {
                 m.values_sorted(col, *dir, &rs, |k, v| out[k * n + d] = v as f32);
             } else {
@@ -807,6 +813,115 @@ impl EarthDensity {
                 }
             }
         }
+    }
+}
+
+/// Columns kept for the next batches that sample the same directions, by the bits of the
+/// direction: the chunks stacked in one column of the shell (3.3 on average in a view near the
+/// ground in the mountains) and the borders that neighbouring chunks share sample the same
+/// directions, and a column (its coarse fields, then its octave ladder as far as the layers
+/// need) is most of a batch's time.
+///
+/// A column's state depends only on its direction and on how far its ladder was refined, and a
+/// sample's value does not change when the ladder is refined further than it needs (the batch's
+/// contract, tested by `a_batch_stops_refining_early_with_the_same_bits_as_points` and
+/// `kept_columns_give_the_same_bits`), so a kept column gives every sample the bits a fresh one
+/// gives. Columns are copied in and out (no allocation per column) under one of
+/// [`ColumnCache::SHARDS`] locks picked by the direction; in each shard two generations bound
+/// the memory: when the newer holds [`ColumnCache::GENERATION`] columns it becomes the older and
+/// the older is dropped.
+pub(crate) struct ColumnCache {
+    shards: Vec<std::sync::Mutex<[ColumnMap; 2]>>,
+}
+
+type ColumnMap = std::collections::HashMap<[u64; 3], EarthColumn, DirHash>;
+
+impl Default for ColumnCache {
+    fn default() -> Self {
+        ColumnCache {
+            shards: (0..Self::SHARDS).map(|_| Default::default()).collect(),
+        }
+    }
+}
+
+/// Hashes a direction's bits (the keys are directions of chunk grids, not chosen by anyone).
+#[derive(Default, Clone, Copy)]
+pub(crate) struct DirHash;
+
+/// The state of [`DirHash`].
+#[derive(Default)]
+pub(crate) struct DirHasher(u64);
+
+impl std::hash::BuildHasher for DirHash {
+    type Hasher = DirHasher;
+    fn build_hasher(&self) -> DirHasher {
+        DirHasher(0)
+    }
+}
+
+impl std::hash::Hasher for DirHasher {
+    fn finish(&self) -> u64 {
+        mix64(self.0)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..b.len()].copy_from_slice(b);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(29) ^ v).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+}
+
+impl ColumnCache {
+    /// Locks the directions are spread over.
+    const SHARDS: usize = 16;
+    /// Columns per generation of a shard (about 1.4 kB each: at most ~45 MB in all).
+    const GENERATION: usize = 1024;
+
+    fn key(dir: DVec3) -> ([u64; 3], usize) {
+        let k = [dir.x.to_bits(), dir.y.to_bits(), dir.z.to_bits()];
+        let h = mix64(k[0] ^ k[1].rotate_left(21) ^ k[2].rotate_left(42));
+        (k, (h >> 60) as usize % Self::SHARDS)
+    }
+
+    fn shard(&self, i: usize) -> std::sync::MutexGuard<'_, [ColumnMap; 2]> {
+        self.shards[i].lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// A copy of the column kept for `dir`, if any.
+    fn get(&self, dir: DVec3) -> Option<EarthColumn> {
+        let (k, i) = Self::key(dir);
+        let maps = self.shard(i);
+        maps[0].get(&k).or_else(|| maps[1].get(&k)).cloned()
+    }
+
+    /// Keeps a copy of `col`, the column of `dir`, unless one refined as far is kept already.
+    fn put(&self, dir: DVec3, col: &EarthColumn) {
+        let (k, i) = Self::key(dir);
+        let mut maps = self.shard(i);
+        if let Some(kept) = maps[0].get_mut(&k) {
+            if kept.done < col.done {
+                kept.clone_from(col);
+            }
+            return;
+        }
+        if maps[1].get(&k).is_some_and(|kept| kept.done >= col.done) {
+            return;
+        }
+        let dropped = if maps[0].len() >= Self::GENERATION {
+            let fresh = ColumnMap::with_capacity_and_hasher(Self::GENERATION, DirHash);
+            let full = std::mem::replace(&mut maps[0], fresh);
+            Some(std::mem::replace(&mut maps[1], full))
+        } else {
+            None
+        };
+        maps[0].insert(k, col.clone());
+        drop(maps);
+        // (the dropped generation is freed outside the lock)
+        drop(dropped);
     }
 }
 
@@ -1506,6 +1621,54 @@ mod tests {
             }
         }
         assert!(caves > 100 && plain > 100, "{caves} cave, {plain} other");
+    }
+
+    #[test]
+    fn kept_columns_give_the_same_bits() {
+        // Batches over the same directions at other radii (other chunks of the column, and
+        // neighbours sharing border directions) leave columns refined to other depths in the
+        // density's cache; a batch reading them gives the bits of a density that never saw them.
+        let (layout, m, warm) = earth(7);
+        let base = sphere_dirs(300)
+            .into_iter()
+            .find(|dir| full(&m, *dir).1 > m.sea + 800.0)
+            .expect("a land column");
+        let h = full(&m, base).1;
+        let step = 3.0 * m.s.l_d / m.sea;
+        let (u, w) = base.any_orthonormal_pair();
+        let dirs: Vec<DVec3> = (0..100)
+            .map(|i| (base + u * (step * f64::from(i % 10)) + w * (step * f64::from(i / 10))).normalize())
+            .collect();
+        let layers = |from: f64, spacing: f64| (0..35).map(|k| from + f64::from(k) * spacing).collect::<Vec<f64>>();
+        let l_d = layout.l_d();
+        // chunks above, across and below the surface, at two levels, some twice
+        let batches = [
+            layers(h + 20.0 * l_d, l_d),
+            layers(h - 15.0 * l_d, l_d),
+            layers(h - 60.0 * l_d, 2.0 * l_d),
+            layers(h - 50.0 * l_d, l_d),
+            layers(h - 15.0 * l_d, l_d),
+            layers(h - 200.0 * l_d, 16.0 * l_d),
+        ];
+        let mut warm_out = vec![0.0f32; dirs.len() * 35];
+        for (b, radii) in batches.iter().enumerate() {
+            // the cold density is a new one each time: it keeps nothing from the others
+            let cold = EarthDensity::new(m.clone());
+            let mut cold_out = vec![0.0f32; dirs.len() * 35];
+            cold.sample_shell(&dirs, radii, &mut cold_out);
+            warm.sample_shell(&dirs, radii, &mut warm_out);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&warm_out), bits(&cold_out), "batch {b}");
+            let mut kept = ShellColumns::default();
+            let mut kept_out = vec![0.0f32; dirs.len() * 35];
+            warm.sample_shell_keeping(&dirs, radii, &mut kept_out, &mut kept);
+            assert_eq!(bits(&kept_out), bits(&cold_out), "batch {b}, keeping");
+        }
+        // and a point call agrees with the warm batch as with a cold one
+        for (k, r) in batches[1].iter().enumerate() {
+            let p = dirs[3] * *r;
+            assert_eq!(warm.density(p), EarthDensity::new(m.clone()).density(p), "layer {k}");
+        }
     }
 
     #[test]
