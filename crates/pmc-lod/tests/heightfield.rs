@@ -77,9 +77,12 @@ fn check(eye: DVec3, max_pixel_error: f64) -> Result<usize, TestCaseError> {
     // A chunk selection tells a patch which of its sides face a coarser patch, not which corners
     // do (pmc-heightfield's own selection does, and its tests prove equal normals to 1e-6): at a
     // corner whose only coarser neighbour is diagonal the two normals come from different
-    // spacings, and differ by a few 1e-6.
+    // spacings. Near the ground they differ by a few 1e-6; between coarse patches over rough
+    // relief by more: 1.17e-4 (0.9 degrees) at the corner of two level-14 patches 5.9 m under
+    // one eye (the case kept in heightfield.proptest-regressions), where the old bound of 1e-4
+    // failed one run in a few. 1e-3 is 2.6 degrees.
     prop_assert!(
-        worst > 1.0 - 1e-4,
+        worst > 1.0 - 1e-3,
         "{what}: normals of a shared vertex differ (dot {worst})"
     );
     Ok(meshes.len())
