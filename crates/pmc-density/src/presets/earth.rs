@@ -665,7 +665,6 @@ impl EarthModel {
                 debug_assert_eq!(n, self.entries.len());
                 self.near_surface(col, dir, col.h[n], r)
             };
-            debug_assert_eq!(v.to_bits(), self.value(col, dir, r).to_bits());
             put(i, v);
         }
     }
@@ -1621,6 +1620,28 @@ mod tests {
             }
         }
         assert!(caves > 100 && plain > 100, "{caves} cave, {plain} other");
+    }
+
+    #[test]
+    fn the_one_way_walk_finds_the_entry_the_search_finds() {
+        // `values_sorted` (two pointers over nested intervals) against `value` (a binary search
+        // per sample), bit for bit, on columns refined to every depth and radii across the surface.
+        let (_, m, _) = earth(7);
+        let mut checked = 0;
+        for (i, dir) in sphere_dirs(300).into_iter().enumerate() {
+            let (_, h) = full(&m, dir);
+            let spacing = [0.5, 1.0, 8.0, 200.0][i % 4];
+            let rs: Vec<f64> = (0..40).map(|k| h - 20.0 * spacing + f64::from(k) * spacing).collect();
+            let mut col = m.column(dir);
+            m.refine_batch(&mut col, dir, &rs, true);
+            let mut got = vec![0.0; rs.len()];
+            m.values_sorted(&col, dir, &rs, |k, v| got[k] = v);
+            for (k, r) in rs.iter().enumerate() {
+                assert_eq!(got[k].to_bits(), m.value(&col, dir, *r).to_bits(), "dir {i}, layer {k}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 300 * 40);
     }
 
     #[test]
