@@ -82,7 +82,7 @@ export async function openBrowser() {
       throw new Error(`${what}: ${e.message}; streaming ${JSON.stringify(s).slice(0, 1500)}`);
     }
     const s = await hookOn(p)(() => window.__pmc.stats());
-    log(`  ready ${what}: ${s.loaded} chunks, ${s.triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+    log(`  ready ${what}: ${s.loaded} chunks, ${s.triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s (${s.draws} draws in ${s.frames} frames so far, a draw ${Math.round(s.drawMs)} ms)`);
     return s;
   };
   const ready = (what) => readyOn(page, what);

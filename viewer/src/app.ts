@@ -110,7 +110,7 @@ export class App implements TestHookTarget {
     });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.connection = new ConnectionMonitor({
-      probe: () => this.api.health().then(() => undefined),
+      probe: (signal) => this.api.health(signal).then(() => undefined),
       onChange: (s) => {
         this.streamer.setPaused(!s.online);
         this.showConnection();
@@ -843,6 +843,7 @@ export class App implements TestHookTarget {
       fps: this.loop.fps,
       frames: this.loop.frames,
       draws: this.loop.draws,
+      drawMs: this.loop.drawMs,
       lat: cam.state.lat,
       lon: cam.state.lon,
       alt: cam.state.alt,

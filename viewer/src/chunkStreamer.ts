@@ -110,6 +110,8 @@ export interface StreamerStats {
   timedOut: number;
   /** Wanted chunks neither loaded nor pending that wait for the back-off of a failure. */
   blocked: number;
+  /** No chunk is requested: the server does not answer (connection.ts probes it). */
+  paused: boolean;
   /** Shown chunks waiting to be fetched again (edited), and refetches under way. */
   stale: number;
   reloading: number;
@@ -684,6 +686,7 @@ export class ChunkStreamer {
       evicted: this.counts.evicted,
       timedOut: this.counts.timedOut,
       blocked,
+      paused: this.paused,
       stale: this.stale.size,
       reloading,
       reloads: this.counts.reloads,

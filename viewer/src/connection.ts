@@ -2,7 +2,9 @@
 // gone: not an HTTP error, not a cancelled request) puts the viewer offline: the notice says so
 // and a probe (`/health`) retries with a back-off, or at once from the notice's button. The first
 // answer, to a probe or to any request, brings the viewer back online, and the app resumes
-// (failed chunks fetched again, the edit stream reopened, the planet reloaded if it changed).
+// (failed chunks fetched again, the edit stream reopened, the planet reloaded if it changed). A
+// probe unanswered after `probeTimeoutMs` is aborted and counts as failed: a probe that hung held
+// the viewer offline for good, and the chunk streamer paused with it.
 // Pure: the probe, the clock and the timers are passed in.
 
 /** What the notice shows. */
@@ -17,8 +19,8 @@ export interface ConnectionState {
 }
 
 export interface ConnectionOptions {
-  /** Resolves when the server answers, rejects when it cannot be reached. */
-  probe(): Promise<void>;
+  /** Resolves when the server answers, rejects when it cannot be reached (or `signal` aborts). */
+  probe(signal: AbortSignal): Promise<void>;
   /** The state changed. */
   onChange(state: ConnectionState): void;
   /** Back online after being offline. */
@@ -29,6 +31,8 @@ export interface ConnectionOptions {
   /** The first probe's delay, ms (doubled after each failed probe up to `maxDelayMs`). */
   firstDelayMs?: number;
   maxDelayMs?: number;
+  /** How long a probe may go unanswered before it counts as failed, ms (default 10 s). */
+  probeTimeoutMs?: number;
 }
 
 /** Milliseconds before probe number `attempt` (0-based): `first` doubled each time, at most `max`. */
@@ -48,6 +52,7 @@ export class ConnectionMonitor {
   private readonly clearTimer: (handle: unknown) => void;
   private readonly first: number;
   private readonly max: number;
+  private readonly probeTimeout: number;
 
   constructor(private readonly opts: ConnectionOptions) {
     this.now = opts.now ?? (() => Date.now());
@@ -55,6 +60,7 @@ export class ConnectionMonitor {
     this.clearTimer = opts.clearTimer ?? ((h) => clearTimeout(h as ReturnType<typeof setTimeout>));
     this.first = opts.firstDelayMs ?? 1000;
     this.max = opts.maxDelayMs ?? 10_000;
+    this.probeTimeout = opts.probeTimeoutMs ?? 10_000;
   }
 
   state(): ConnectionState {
@@ -114,13 +120,21 @@ export class ConnectionMonitor {
     this.nextAt = null;
     this.attempts++;
     this.opts.onChange(this.state());
-    let ok = false;
-    try {
-      await this.opts.probe();
-      ok = true;
-    } catch {
-      ok = false;
-    }
+    const abort = new AbortController();
+    let expire: () => void = () => undefined;
+    const expired = new Promise<boolean>((resolve) => {
+      expire = () => resolve(false);
+    });
+    const timer = this.setTimer(() => {
+      abort.abort();
+      expire();
+    }, this.probeTimeout);
+    const answered = this.opts.probe(abort.signal).then(
+      () => true,
+      () => false,
+    );
+    const ok = await Promise.race([answered, expired]);
+    this.clearTimer(timer);
     this.probing = false;
     if (this.online) return;
     if (ok) this.reached();

@@ -64,6 +64,8 @@ export class FrameLoop {
   /** Frames that drew. */
   draws = 0;
   private readonly redraw = new RedrawPolicy();
+  /** When the GPU finished the frames drawn (a fence after a drawn frame). */
+  private readonly gpu: GpuTimer;
   /** The key of the last picture drawn (render on demand: see pictureKey.ts). */
   private readonly pictureKey = new PictureKey();
   private readonly key: number[] = [];
@@ -72,7 +74,15 @@ export class FrameLoop {
   constructor(
     private readonly parts: FrameParts,
     private readonly steps: FrameSteps,
-  ) {}
+  ) {
+    const gl = parts.renderer.getContext();
+    this.gpu = new GpuTimer('fenceSync' in gl ? gl : null);
+  }
+
+  /** Milliseconds a drawn frame costs (the redraw policy's measure: see `RedrawPolicy.costMs`). */
+  get drawMs(): number {
+    return this.redraw.costMs;
+  }
 
   start(): void {
     this.parts.renderer.setAnimationLoop(() => this.frame());
@@ -96,6 +106,7 @@ export class FrameLoop {
   private draw(now: number): void {
     const { renderer, scene, cameras } = this.parts;
     renderer.render(scene.scene, cameras.camera);
+    this.gpu.drew(now);
     this.redraw.drew(now);
     this.pictureKey.drew(this.key);
     this.draws++;
@@ -123,6 +134,8 @@ export class FrameLoop {
     const now = performance.now();
     const dt = Math.min(0.1, Math.max(0, (now - this.lastFrame) / 1000));
     this.redraw.frameStarted(now - this.lastFrame);
+    const gpuMs = this.gpu.poll(now);
+    if (gpuMs !== null) this.redraw.gpuFinished(gpuMs);
     this.lastFrame = now;
     this.frames++;
     this.fpsFrames++;
@@ -166,7 +179,7 @@ export class FrameLoop {
 
     const settled = streamer.settled();
     const changed = this.pictureKey.changed(this.frameKey(pos));
-    if (this.redraw.shouldDraw(now, moved || inputActive(input), settled, changed)) this.draw(now);
+    if (this.redraw.shouldDraw(now, moved || inputActive(input), settled, changed, this.gpu.busy)) this.draw(now);
 
     const st = streamer.stats();
     readiness.frame(!flying && steps.busy() === null && selection.current() && settled);
@@ -222,15 +235,25 @@ function inputActive(input: InputFrame): boolean {
  * same uniforms: `changed` false) does not draw. Otherwise every frame draws, except on a slow
  * renderer (software WebGL, an old GPU: over SLOW_FRAME_MS a drawn frame) while chunks stream in
  * under a still camera: then the picture is redrawn every STREAMING_REDRAW_MS, or once in
- * STREAMING_DRAW_SHARE frame times when drawing takes longer. A busy GPU holds up what the page
- * sends it (chunk uploads, the compositor's read back of the canvas) until the frame before is
- * done, so redrawing a picture that changes by a few chunks at a time would starve the streaming
- * (by 20 times with software WebGL on two cores). A camera that moves, or input, draws at once; a
- * settled view draws as soon as it changed.
+ * STREAMING_DRAW_SHARE frame times when drawing takes longer, and never while the GPU is still
+ * drawing the last one. A busy GPU holds up what the page sends it (chunk uploads, the
+ * compositor's read back of the canvas) until the frame before is done, so redrawing a picture
+ * that changes by a few chunks at a time would starve the streaming (by 20 times with software
+ * WebGL on two cores). A camera that moves, or input, draws at once; a settled view draws as soon
+ * as it changed.
+ *
+ * A frame's cost is the longer of two measures: the interval from a frame that drew to the next
+ * (what drawing held up the page's own thread), and the time from a draw to the GPU having
+ * finished it (a fence, `GpuTimer`). The second is the one that counts under a software
+ * renderer: three.js hands the frame over at once and the GPU process then draws it on every
+ * core for seconds (12 s for a 2 m view of the Earth at 1024 x 640 on two cores), while the
+ * interval after the draw said a second.
  */
 export class RedrawPolicy {
   /** Milliseconds a frame that draws takes (a running mean of the intervals after drawing). */
   renderMs = 0;
+  /** Milliseconds from a draw to the GPU having finished it (a running mean; 0: not measured). */
+  gpuMs = 0;
   private lastDraw = Number.NEGATIVE_INFINITY;
   private drewLast = false;
 
@@ -240,15 +263,36 @@ export class RedrawPolicy {
     this.drewLast = false;
   }
 
+  /** A drawn frame was finished by the GPU `ms` after it was drawn. */
+  gpuFinished(ms: number): void {
+    this.gpuMs = this.gpuMs === 0 ? ms : 0.8 * this.gpuMs + 0.2 * ms;
+  }
+
+  /** What a drawn frame costs, milliseconds: the longer of the two measures. */
+  get costMs(): number {
+    return Math.max(this.renderMs, this.gpuMs);
+  }
+
+  /**
+   * Whether the renderer is slow: a frame interval after drawing over SLOW_FRAME_MS, or a draw
+   * the GPU finished over SLOW_GPU_MS later (the fence is read once a frame, so on a fast GPU
+   * the second measure is a frame or two of the display's, 33 ms at 60 Hz, 66 ms at 30 Hz).
+   */
+  get slow(): boolean {
+    return this.renderMs >= SLOW_FRAME_MS || this.gpuMs >= SLOW_GPU_MS;
+  }
+
   /**
    * Whether the frame starting at `now` draws (`active`: the camera moved or input came;
-   * `changed`: its picture differs from the last drawn).
+   * `changed`: its picture differs from the last drawn; `gpuBusy`: the GPU has not finished
+   * the last frame drawn).
    */
-  shouldDraw(now: number, active: boolean, settled: boolean, changed = true): boolean {
+  shouldDraw(now: number, active: boolean, settled: boolean, changed = true, gpuBusy = false): boolean {
     if (active) return true;
     if (!changed) return false;
-    if (settled || this.renderMs < SLOW_FRAME_MS) return true;
-    return now - this.lastDraw >= Math.max(STREAMING_REDRAW_MS, STREAMING_DRAW_SHARE * this.renderMs);
+    if (settled || !this.slow) return true;
+    if (gpuBusy) return false;
+    return now - this.lastDraw >= Math.max(STREAMING_REDRAW_MS, STREAMING_DRAW_SHARE * this.costMs);
   }
 
   /** The frame starting at `now` drew. */
@@ -258,8 +302,49 @@ export class RedrawPolicy {
   }
 }
 
+/** The parts of a WebGL 2 context `GpuTimer` uses. */
+export type FenceContext = Pick<
+  WebGL2RenderingContext,
+  'fenceSync' | 'getSyncParameter' | 'deleteSync' | 'SYNC_GPU_COMMANDS_COMPLETE' | 'SYNC_STATUS' | 'SIGNALED'
+>;
+
+/**
+ * When the GPU finished a drawn frame: a fence follows a draw (one at a time: a draw while one is
+ * out is not timed), and each frame asks whether it has signalled, which never blocks. Without
+ * WebGL 2 (or with a lost context) nothing is measured and the GPU is never busy.
+ */
+export class GpuTimer {
+  private sync: WebGLSync | null = null;
+  private since = 0;
+
+  constructor(private readonly gl: FenceContext | null) {}
+
+  /** A frame was drawn at `now`. */
+  drew(now: number): void {
+    if (this.gl === null || this.sync !== null) return;
+    this.sync = this.gl.fenceSync(this.gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+    this.since = now;
+  }
+
+  /** Whether the GPU is still drawing the frame timed. */
+  get busy(): boolean {
+    return this.sync !== null;
+  }
+
+  /** At `now`: the milliseconds the timed frame took if the GPU finished it since, else null. */
+  poll(now: number): number | null {
+    if (this.gl === null || this.sync === null) return null;
+    if (this.gl.getSyncParameter(this.sync, this.gl.SYNC_STATUS) !== this.gl.SIGNALED) return null;
+    this.gl.deleteSync(this.sync);
+    this.sync = null;
+    return now - this.since;
+  }
+}
+
 /** A drawn frame slower than this (ms) makes a slow renderer (see `RedrawPolicy`). */
 export const SLOW_FRAME_MS = 50;
+/** ...and so does a draw the GPU finishes this much later (ms; see `RedrawPolicy.slow`). */
+export const SLOW_GPU_MS = 200;
 /** How often a slow renderer redraws a still view while chunks stream in (ms)... */
 export const STREAMING_REDRAW_MS = 400;
 /** ...or at most once in this many frame times (drawing takes at most a quarter of the time). */

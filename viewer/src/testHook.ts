@@ -51,6 +51,8 @@ export interface PmcStats {
   /** Animation frames so far, and the frames of them that drew (a still, settled view draws nothing). */
   frames: number;
   draws: number;
+  /** What a drawn frame costs, milliseconds (the longer of its frame interval and its time on the GPU). */
+  drawMs: number;
   lat: number;
   lon: number;
   alt: number;

@@ -4,17 +4,28 @@
 import { describe, expect, it } from 'vitest';
 import { ConnectionMonitor, offlineMessage, probeDelay, type ConnectionState } from '../src/connection';
 
-function harness(probeResults: boolean[]) {
+function harness(probeResults: (boolean | 'hang')[]) {
   let now = 0;
   const timers: { at: number; fn: () => void; id: number }[] = [];
   let nextId = 1;
   const states: ConnectionState[] = [];
   let onlines = 0;
   let probes = 0;
+  let aborted = 0;
   const m = new ConnectionMonitor({
-    probe: () => {
+    probe: (signal) => {
       probes++;
-      return probeResults.shift() ? Promise.resolve() : Promise.reject(new Error('refused'));
+      const r = probeResults.shift();
+      if (r === 'hang') {
+        // never answered: settles only when the monitor gives it up
+        return new Promise<void>((_, reject) =>
+          signal.addEventListener('abort', () => {
+            aborted++;
+            reject(new Error('aborted'));
+          }),
+        );
+      }
+      return r ? Promise.resolve() : Promise.reject(new Error('refused'));
     },
     onChange: (s) => states.push(s),
     onOnline: () => onlines++,
@@ -42,7 +53,7 @@ function harness(probeResults: boolean[]) {
     }
     now = t;
   };
-  return { m, states, advance, onlines: () => onlines, probes: () => probes, pending: () => timers.length };
+  return { m, states, advance, onlines: () => onlines, probes: () => probes, aborted: () => aborted, pending: () => timers.length };
 }
 
 describe('ConnectionMonitor', () => {
@@ -88,5 +99,24 @@ describe('ConnectionMonitor', () => {
     expect(offlineMessage({ ...s, nextProbeAt: null }, 5000)).toMatch(/trying now/);
     expect(offlineMessage({ online: true, since: null, attempts: 0, nextProbeAt: null }, 0)).toBeNull();
     expect([0, 1, 2, 3, 4, 30].map((a) => probeDelay(a))).toEqual([1000, 2000, 4000, 8000, 10_000, 10_000]);
+  });
+
+  it('a probe that never answers does not keep the viewer offline (the chunk streamer paused with it)', async () => {
+    const h = harness(['hang', 'hang', true]);
+    h.m.unreachable();
+    await h.advance(1000);
+    expect([h.probes(), h.m.state().nextProbeAt]).toEqual([1, null]);
+    // the first probe hangs: given up after 10 s, the next one after the back-off (2 s)
+    await h.advance(10_999);
+    expect([h.probes(), h.aborted(), h.m.state().online]).toEqual([1, 0, false]);
+    await h.advance(11_000);
+    expect([h.aborted(), h.m.state().nextProbeAt]).toEqual([1, 13_000]);
+    await h.advance(13_000);
+    expect(h.probes()).toBe(2);
+    // so does the second; the third answers
+    await h.advance(23_000);
+    expect([h.aborted(), h.m.state().nextProbeAt]).toEqual([2, 27_000]);
+    await h.advance(27_000);
+    expect([h.probes(), h.m.state().online, h.onlines(), h.pending()]).toEqual([3, true, 1, 0]);
   });
 });
