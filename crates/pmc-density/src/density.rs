@@ -125,11 +125,26 @@ impl ShellColumns {
     /// and shader): `fill` writes them into an empty vector (reusing the previous allocation
     /// when its type matches) and must push one per direction.
     pub fn keep<T: Send + Sync + 'static>(&mut self, owner: usize, dirs: &[DVec3], fill: impl FnOnce(&mut Vec<T>)) {
+        self.keep_reusing(owner, dirs, |values: &mut Vec<T>| {
+            values.clear();
+            fill(values)
+        });
+    }
+
+    /// As [`ShellColumns::keep`], but `fill` gets the vector with the values kept before, when
+    /// their type matches (to overwrite in place: large values then cost no copy of a whole
+    /// value), and must leave exactly one value per direction in it (values of any other count
+    /// are never read).
+    pub fn keep_reusing<T: Send + Sync + 'static>(
+        &mut self,
+        owner: usize,
+        dirs: &[DVec3],
+        fill: impl FnOnce(&mut Vec<T>),
+    ) {
         let mut values: Box<Vec<T>> = match self.values.take().map(|v| v.downcast::<Vec<T>>()) {
             Some(Ok(v)) => v,
             _ => Box::default(),
         };
-        values.clear();
         fill(&mut values);
         self.owner = owner;
         self.dirs.clear();

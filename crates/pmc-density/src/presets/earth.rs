@@ -195,8 +195,8 @@ pub(crate) struct EarthColumn {
     h: [f64; MAX_ENTRIES + 1],
     keep_lo: [f64; MAX_ENTRIES + 1],
     keep_hi: [f64; MAX_ENTRIES + 1],
-    /// The bound on the remaining octaves after `k` entries.
-    rem: [f64; MAX_ENTRIES + 1],
+    /// The bound on the remaining octaves after the `done` entries evaluated.
+    rem: f64,
     /// Noise of upcoming entries, evaluated eight at a time: `noise[l]` is entry `noise_of[l]`'s
     /// (`usize::MAX`: none).
     noise: [f64; LANES],
@@ -215,6 +215,34 @@ impl EarthColumn {
     #[inline]
     fn keeps(&self, k: usize, r: f64) -> bool {
         self.keep_lo[k] < r && r < self.keep_hi[k]
+    }
+
+    /// Makes `self` the column `src` as far as it is refined: the entries after `src.done` are
+    /// not copied (whatever they hold is never read: every read is at an entry up to `done`, and
+    /// `advance` writes an entry before reading it). A column is 1.6 kB, most of it entries a
+    /// column refined part of the way never fills, and the column cache's copies were a sixth of
+    /// a cold teleport's time when they were whole.
+    fn copy_refined(&mut self, src: &EarthColumn) {
+        let n = src.done + 1;
+        self.factor = src.factor;
+        self.a_rock = src.a_rock;
+        self.a_cliff = src.a_cliff;
+        self.mountains = src.mountains;
+        self.cave_gate = src.cave_gate;
+        self.roof = src.roof;
+        self.w_down = src.w_down;
+        self.w_up = src.w_up;
+        self.done = src.done;
+        self.linear = src.linear;
+        self.ridge = src.ridge;
+        self.weight = src.weight;
+        self.h[..n].copy_from_slice(&src.h[..n]);
+        self.keep_lo[..n].copy_from_slice(&src.keep_lo[..n]);
+        self.keep_hi[..n].copy_from_slice(&src.keep_hi[..n]);
+        self.rem = src.rem;
+        self.noise = src.noise;
+        self.noise_of = src.noise_of;
+        self.noise_next = src.noise_next;
     }
 }
 
@@ -399,6 +427,35 @@ impl EarthModel {
     }
 
     pub(crate) fn column(&self, dir: DVec3) -> EarthColumn {
+        let mut col = EarthColumn {
+            factor: [0.0; 4],
+            a_rock: 0.0,
+            a_cliff: 0.0,
+            mountains: 0.0,
+            cave_gate: 0.0,
+            roof: 0.0,
+            w_down: 0.0,
+            w_up: 0.0,
+            done: 0,
+            linear: 0.0,
+            ridge: 0.0,
+            weight: 1.0,
+            h: [0.0; MAX_ENTRIES + 1],
+            keep_lo: [0.0; MAX_ENTRIES + 1],
+            keep_hi: [0.0; MAX_ENTRIES + 1],
+            rem: 0.0,
+            noise: [0.0; LANES],
+            noise_of: [usize::MAX; LANES],
+            noise_next: LANES,
+        };
+        self.column_into(dir, &mut col);
+        col
+    }
+
+    /// Makes `col` the column of `dir` with no entry evaluated, in place: its entries after the
+    /// first are left as they were (never read before `advance` writes them, as with
+    /// [`EarthColumn::copy_refined`]), so a column reused costs no copy of the whole.
+    pub(crate) fn column_into(&self, dir: DVec3, col: &mut EarthColumn) {
         let v = self.vert;
         let e = self.continent(dir);
         // Ocean: a shelf, then the abyssal floor (its depth varying between basins), and trenches
@@ -461,33 +518,26 @@ impl EarthModel {
             (0.0, 0.0)
         };
         let margin = self.s.l_d + 1e-6 * self.s.thickness;
-        let mut col = EarthColumn {
-            factor,
-            mountains,
-            a_rock,
-            a_cliff,
-            cave_gate,
-            roof,
-            w_down: over.max(cave_down) + margin,
-            w_up: over.max(cave_up) + margin,
-            done: 0,
-            linear: base,
-            ridge: 0.0,
-            weight: 1.0,
-            h: [0.0; MAX_ENTRIES + 1],
-            keep_lo: [0.0; MAX_ENTRIES + 1],
-            keep_hi: [0.0; MAX_ENTRIES + 1],
-            rem: [0.0; MAX_ENTRIES + 1],
-            noise: [0.0; LANES],
-            noise_of: [usize::MAX; LANES],
-            noise_next: LANES,
-        };
+        col.factor = factor;
+        col.mountains = mountains;
+        col.a_rock = a_rock;
+        col.a_cliff = a_cliff;
+        col.cave_gate = cave_gate;
+        col.roof = roof;
+        col.w_down = over.max(cave_down) + margin;
+        col.w_up = over.max(cave_up) + margin;
+        col.done = 0;
+        col.linear = base;
+        col.ridge = 0.0;
+        col.weight = 1.0;
+        col.noise = [0.0; LANES];
+        col.noise_of = [usize::MAX; LANES];
+        col.noise_next = LANES;
         col.h[0] = base;
-        self.set_keep(&mut col, 0, f64::NEG_INFINITY, f64::INFINITY);
-        col
+        self.set_keep(col, 0, f64::NEG_INFINITY, f64::INFINITY);
     }
 
-    /// Records the remaining bound after `k` entries and the radii that keep refining.
+    /// Records the remaining bound after `k` entries (`k` is `col.done`) and the radii that keep refining.
     #[inline]
     fn set_keep(&self, col: &mut EarthColumn, k: usize, lo: f64, hi: f64) {
         let f = &col.factor;
@@ -495,7 +545,7 @@ impl EarthModel {
         let ridge_left = sums[Part::Ridge as usize];
         let rem = f[0] * sums[0] + f[1] * sums[1] + f[3] * sums[3] + f[2] * ridge_left * (2.0 * col.ridge + ridge_left);
         let h = col.h[k];
-        col.rem[k] = rem;
+        col.rem = rem;
         col.keep_lo[k] = lo.max(h - (rem + col.w_down).max(STOP_FACTOR * rem));
         col.keep_hi[k] = hi.min(h + (rem + col.w_up).max(STOP_FACTOR * rem));
     }
@@ -561,7 +611,7 @@ impl EarthModel {
 
     /// Refines `col` until its height is known within `tol` metres (or the ladder ends).
     pub(crate) fn refine_to(&self, col: &mut EarthColumn, dir: DVec3, tol: f64) {
-        while col.done < self.entries.len() && col.rem[col.done] > tol {
+        while col.done < self.entries.len() && col.rem > tol {
             self.advance(col, dir);
         }
     }
@@ -569,7 +619,7 @@ impl EarthModel {
     /// Whether `h - r > depth` for the column's full height `h` (every entry), refining only
     /// until the sound bound on the remaining octaves settles the comparison.
     pub(crate) fn deeper_than(&self, col: &mut EarthColumn, dir: DVec3, r: f64, depth: f64) -> bool {
-        while col.done < self.entries.len() && (col.h[col.done] - r - depth).abs() <= col.rem[col.done] {
+        while col.done < self.entries.len() && (col.h[col.done] - r - depth).abs() <= col.rem {
             self.advance(col, dir);
         }
         col.height() - r > depth
@@ -781,24 +831,36 @@ impl EarthDensity {
         // order (each rounded operation is monotone), so the samples still refining form one
         // run of them.
         let sorted = radii.windows(2).all(|w| w[0] <= w[1]) && radii.first().is_none_or(|r| *r >= 0.0);
+        // `kept` holds the columns of an earlier batch: each is overwritten in place (a kept
+        // column is copied only as far as it is refined), new ones pushed.
         if let Some(k) = kept.as_deref_mut() {
-            k.clear();
-            k.reserve(n);
+            k.truncate(n);
         }
-        let mut scratch = None;
+        let mut scratch: Option<EarthColumn> = None;
         for (d, dir) in dirs.iter().enumerate() {
             for (x, r) in rs.iter_mut().zip(radii) {
                 *x = (*dir * *r).length();
             }
-            let found = self.1.get(*dir);
-            let done = found.as_ref().map(|c| c.done);
-            let start = found.unwrap_or_else(|| m.column(*dir));
-            let col = match kept.as_deref_mut() {
+            // (`fresh`: the slot was just made, as the column of `dir`)
+            let (col, fresh) = match kept.as_deref_mut() {
+                Some(k) if d < k.len() => (&mut k[d], false),
                 Some(k) => {
-                    k.push(start);
-                    k.last_mut().expect("just pushed")
+                    k.push(m.column(*dir));
+                    (k.last_mut().expect("just pushed"), true)
                 }
-                None => scratch.insert(start),
+                None => match scratch {
+                    Some(ref mut c) => (c, false),
+                    None => (scratch.insert(m.column(*dir)), true),
+                },
+            };
+            // the column as far as the cache has it, else a fresh one
+            let done = if self.1.get_into(*dir, col) {
+                Some(col.done)
+            } else {
+                if !fresh {
+                    m.column_into(*dir, col);
+                }
+                None
             };
             m.refine_batch(col, *dir, &rs, sorted);
             if done.is_none_or(|d| d < col.done) {
@@ -825,21 +887,35 @@ impl EarthDensity {
 /// sample's value does not change when the ladder is refined further than it needs (the batch's
 /// contract, tested by `a_batch_stops_refining_early_with_the_same_bits_as_points` and
 /// `kept_columns_give_the_same_bits`), so a kept column gives every sample the bits a fresh one
-/// gives. Columns are copied in and out (no allocation per column) under one of
+/// gives. Columns are copied in and out as far as they are refined (`EarthColumn::copy_refined`:
+/// no allocation, and no copy of the entries a column never filled) under one of
 /// [`ColumnCache::SHARDS`] locks picked by the direction; in each shard two generations bound
-/// the memory: when the newer holds [`ColumnCache::GENERATION`] columns it becomes the older and
-/// the older is dropped.
+/// the memory: when the newer holds [`ColumnCache::GENERATION`] columns it becomes the older, and
+/// the older is emptied and filled again in place as the newer.
 pub(crate) struct ColumnCache {
-    shards: Vec<std::sync::Mutex<[ColumnMap; 2]>>,
+    shards: Vec<Shard>,
+    /// Columns per generation of a shard ([`ColumnCache::GENERATION`]; fewer in tests).
+    generation: usize,
 }
 
-type ColumnMap = std::collections::HashMap<[u64; 3], EarthColumn, DirHash>;
+/// A shard's lock, alone on its cache lines: the two workers of a 2-core machine mesh
+/// neighbouring chunks, which share directions and shards, and shards packed side by side made
+/// the lock's cache line bounce between the cores even for different shards.
+#[repr(align(128))]
+#[derive(Default)]
+struct Shard(std::sync::Mutex<[Generation; 2]>);
+
+/// A generation of a shard of the [`ColumnCache`]: the columns, and their slots by direction.
+/// A generation dropped is emptied and reused as the newest (its slots overwritten in place).
+#[derive(Default)]
+struct Generation {
+    slots: std::collections::HashMap<[u64; 3], u32, DirHash>,
+    columns: Vec<EarthColumn>,
+}
 
 impl Default for ColumnCache {
     fn default() -> Self {
-        ColumnCache {
-            shards: (0..Self::SHARDS).map(|_| Default::default()).collect(),
-        }
+        Self::with_generation(Self::GENERATION)
     }
 }
 
@@ -876,51 +952,70 @@ impl std::hash::Hasher for DirHasher {
 
 impl ColumnCache {
     /// Locks the directions are spread over.
-    const SHARDS: usize = 16;
-    /// Columns per generation of a shard (about 1.4 kB each: at most ~45 MB in all).
-    const GENERATION: usize = 1024;
+    const SHARDS: usize = 64;
+    /// Columns per generation of a shard (about 1.6 kB each: at most ~52 MB in all).
+    const GENERATION: usize = 256;
+
+    /// An empty cache of `generation` columns per generation of a shard.
+    fn with_generation(generation: usize) -> Self {
+        ColumnCache {
+            shards: (0..Self::SHARDS).map(|_| Default::default()).collect(),
+            generation: generation.max(1),
+        }
+    }
 
     fn key(dir: DVec3) -> ([u64; 3], usize) {
         let k = [dir.x.to_bits(), dir.y.to_bits(), dir.z.to_bits()];
         let h = mix64(k[0] ^ k[1].rotate_left(21) ^ k[2].rotate_left(42));
-        (k, (h >> 60) as usize % Self::SHARDS)
+        (k, (h >> 58) as usize % Self::SHARDS)
     }
 
-    fn shard(&self, i: usize) -> std::sync::MutexGuard<'_, [ColumnMap; 2]> {
-        self.shards[i].lock().unwrap_or_else(|e| e.into_inner())
+    fn shard(&self, i: usize) -> std::sync::MutexGuard<'_, [Generation; 2]> {
+        self.shards[i].0.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// A copy of the column kept for `dir`, if any.
-    fn get(&self, dir: DVec3) -> Option<EarthColumn> {
+    /// Makes `col` the column kept for `dir` (as far as it is refined), if one is kept.
+    fn get_into(&self, dir: DVec3, col: &mut EarthColumn) -> bool {
         let (k, i) = Self::key(dir);
-        let maps = self.shard(i);
-        maps[0].get(&k).or_else(|| maps[1].get(&k)).cloned()
+        let shard = self.shard(i);
+        for g in shard.iter() {
+            if let Some(&slot) = g.slots.get(&k) {
+                col.copy_refined(&g.columns[slot as usize]);
+                return true;
+            }
+        }
+        false
     }
 
     /// Keeps a copy of `col`, the column of `dir`, unless one refined as far is kept already.
     fn put(&self, dir: DVec3, col: &EarthColumn) {
         let (k, i) = Self::key(dir);
-        let mut maps = self.shard(i);
-        if let Some(kept) = maps[0].get_mut(&k) {
+        let mut shard = self.shard(i);
+        if let Some(&slot) = shard[0].slots.get(&k) {
+            let kept = &mut shard[0].columns[slot as usize];
             if kept.done < col.done {
-                kept.clone_from(col);
+                kept.copy_refined(col);
             }
             return;
         }
-        if maps[1].get(&k).is_some_and(|kept| kept.done >= col.done) {
-            return;
+        if let Some(&slot) = shard[1].slots.get(&k) {
+            if shard[1].columns[slot as usize].done >= col.done {
+                return;
+            }
         }
-        let dropped = if maps[0].len() >= Self::GENERATION {
-            let fresh = ColumnMap::with_capacity_and_hasher(Self::GENERATION, DirHash);
-            let full = std::mem::replace(&mut maps[0], fresh);
-            Some(std::mem::replace(&mut maps[1], full))
+        if shard[0].slots.len() >= self.generation {
+            // the newer generation becomes the older; the older is emptied to be the newer
+            shard.swap(0, 1);
+            shard[0].slots.clear();
+        }
+        let g = &mut shard[0];
+        let slot = g.slots.len();
+        if slot < g.columns.len() {
+            g.columns[slot].copy_refined(col);
         } else {
-            None
-        };
-        maps[0].insert(k, col.clone());
-        drop(maps);
-        // (the dropped generation is freed outside the lock)
-        drop(dropped);
+            g.columns.push(col.clone());
+        }
+        g.slots.insert(k, slot as u32);
     }
 }
 
@@ -955,7 +1050,7 @@ impl Density for EarthDensity {
     /// as far as the batch's layers needed) for the shader ([`EarthMaterials`]).
     fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
         let owner = model_key(&self.0);
-        columns.keep(owner, dirs, |kept: &mut Vec<EarthColumn>| {
+        columns.keep_reusing(owner, dirs, |kept: &mut Vec<EarthColumn>| {
             self.batch(dirs, radii, out, Some(kept))
         });
     }
@@ -1054,14 +1149,10 @@ impl EarthModel {
         loop {
             let (ka, kb) = (ca.done, cb.done);
             let h = lerp(ca.h[ka], cb.h[kb], t);
-            let rem = lerp(ca.rem[ka], cb.rem[kb], t);
+            let rem = lerp(ca.rem, cb.rem, t);
             // Refine the column whose bound weighs most (of those that can go on and count).
-            let wa = if ka < len && t < 1.0 {
-                (1.0 - t) * ca.rem[ka]
-            } else {
-                -1.0
-            };
-            let wb = if kb < len && t > 0.0 { t * cb.rem[kb] } else { -1.0 };
+            let wa = if ka < len && t < 1.0 { (1.0 - t) * ca.rem } else { -1.0 };
+            let wb = if kb < len && t > 0.0 { t * cb.rem } else { -1.0 };
             if (h - r - depth).abs() > rem || (wa < 0.0 && wb < 0.0) {
                 return h - r > depth;
             }
@@ -1684,6 +1775,27 @@ mod tests {
             let mut kept_out = vec![0.0f32; dirs.len() * 35];
             warm.sample_shell_keeping(&dirs, radii, &mut kept_out, &mut kept);
             assert_eq!(bits(&kept_out), bits(&cold_out), "batch {b}, keeping");
+        }
+        // A cache of three columns a shard recycles its slots all the time (a slot then holds
+        // the entries of deeper columns past the `done` of the one copied in), and one keeper
+        // reused over batches of other directions holds other columns in every slot: the same
+        // bits again.
+        let small = EarthDensity(m.clone(), ColumnCache::with_generation(3));
+        let mut kept = ShellColumns::default();
+        for round in 0..3 {
+            for (b, radii) in batches.iter().enumerate() {
+                let mut these = dirs.clone();
+                if (b + round) % 2 == 1 {
+                    these.reverse();
+                }
+                these.truncate(100 - 10 * ((b + round) % 4));
+                let mut cold_out = vec![0.0f32; these.len() * 35];
+                EarthDensity::new(m.clone()).sample_shell(&these, radii, &mut cold_out);
+                let mut out = vec![0.0f32; these.len() * 35];
+                small.sample_shell_keeping(&these, radii, &mut out, &mut kept);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&out), bits(&cold_out), "round {round}, batch {b}, a small cache");
+            }
         }
         // and a point call agrees with the warm batch as with a cold one
         for (k, r) in batches[1].iter().enumerate() {
