@@ -7,7 +7,7 @@
 //   PMC_DRAW_VIEWS='100 m,2 m'  only these views
 
 import { openBrowser } from './browser.mjs';
-import { cleanups, log } from './harness.mjs';
+import { cleanup, log } from './harness.mjs';
 import { startBackend } from './servers.mjs';
 
 const N = Number(process.argv[2] ?? 5);
@@ -48,5 +48,5 @@ try {
     log(`${label}: ${s.shown} chunks, ${s.triangles} triangles; a frame ${ms.map((x) => x.toFixed(0)).join(' ')} ms (median ${ms[Math.floor(ms.length / 2)].toFixed(0)})`);
   }
 } finally {
-  for (const c of cleanups.reverse()) await c();
+  await cleanup();
 }

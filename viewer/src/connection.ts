@@ -121,20 +121,16 @@ export class ConnectionMonitor {
     this.attempts++;
     this.opts.onChange(this.state());
     const abort = new AbortController();
-    let expire: () => void = () => undefined;
-    const expired = new Promise<boolean>((resolve) => {
-      expire = () => resolve(false);
+    const ok = await new Promise<boolean>((resolve) => {
+      const timer = this.setTimer(() => {
+        abort.abort();
+        resolve(false);
+      }, this.probeTimeout);
+      this.opts.probe(abort.signal).then(
+        () => resolve(true),
+        () => resolve(false),
+      ).finally(() => this.clearTimer(timer));
     });
-    const timer = this.setTimer(() => {
-      abort.abort();
-      expire();
-    }, this.probeTimeout);
-    const answered = this.opts.probe(abort.signal).then(
-      () => true,
-      () => false,
-    );
-    const ok = await Promise.race([answered, expired]);
-    this.clearTimer(timer);
     this.probing = false;
     if (this.online) return;
     if (ok) this.reached();
