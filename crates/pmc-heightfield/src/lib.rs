@@ -84,7 +84,9 @@ pub use lattice::{
     canonical_lattice, face_lattice, lattice_direction, resolution, CANONICAL_RESOLUTION, MAX_LEVEL, PATCH_SEGMENTS,
     PATCH_SIDE,
 };
-pub use mesh::{generate_patch, patch_indices, vertex_canonical_lattice, vertex_position, PATCH_COLOR};
+pub use mesh::{
+    generate_patch, patch_height_range, patch_indices, vertex_canonical_lattice, vertex_position, PATCH_COLOR,
+};
 pub use patch::{Corner, PatchError, PatchKey, Side, Stitch};
 pub use select::{
     check_selection, patch_corners, select, BoundingSphere, HeightfieldPlanet, SelectedPatch, View, LIPSCHITZ,

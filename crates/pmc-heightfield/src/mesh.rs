@@ -202,6 +202,38 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
     Ok(())
 }
 
+/// The least and greatest height (metres above the datum) of the 65 × 65 vertices of patch
+/// `key`: the heights [`generate_patch`] gives them, bit for bit. Every vertex of the patch's
+/// mesh, whatever its stitching, is one of them (a stitched side drops vertices, it adds none),
+/// so the mesh lies between the radii `datum + low` and `datum + high` (a triangle lies in the
+/// convex hull of its corners). Selections bound a patch by these instead of the whole relief.
+///
+/// Refuses keys that [`PatchKey::validate`] refuses.
+pub fn patch_height_range<H: LatticeHeights + ?Sized>(heights: &H, key: PatchKey) -> Result<(f64, f64), PatchError> {
+    key.validate()?;
+    let m = key.resolution();
+    Ok(SCRATCH.with(|scratch| {
+        let mut scratch = scratch.borrow_mut();
+        let Scratch { lattice, hs, .. } = &mut *scratch;
+        fill_lattice(key, lattice);
+        hs.resize(lattice.len(), 0.0);
+        let grid = FaceGrid {
+            face: key.face,
+            i0: SEG * i64::from(key.i) - 1,
+            j0: SEG * i64::from(key.j) - 1,
+            side: GRID,
+        };
+        heights.heights_on_grid(&grid, lattice, m as i32, hs);
+        hs.chunks_exact(GRID)
+            .skip(1)
+            .take(SIDE)
+            .flat_map(|row| &row[1..=SIDE])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
+                (lo.min(h), hi.max(h))
+            })
+    }))
+}
+
 /// The positions of the sample grid, `lattice_direction(p, m) * (radius + h)` with the same bits:
 /// on the patch's face, the cube-to-sphere factor of the component along the face's `u` axis
 /// depends on the row alone and the one along `v` on the column alone, so they are computed once
@@ -430,5 +462,45 @@ mod tests {
             }
             assert_eq!(area, 2 * 64 * 64);
         }
+    }
+
+    /// A patch's height range is its mesh's: the least and greatest vertex height, with the
+    /// mesher's bits, for every stitching, on every face, at coarse and fine levels.
+    #[test]
+    fn height_range_is_the_mesh_vertices_range() {
+        let ripples = crate::Ripples {
+            amplitude: 800.0,
+            frequency: 23.0,
+        };
+        let mut mesh = ChunkMesh::default();
+        for face in Face::ALL {
+            for (level, i, j) in [(0u8, 0u32, 0u32), (2, 3, 1), (5, 17, 30), (9, 511, 0)] {
+                let key = PatchKey::new(face, level, i, j).unwrap();
+                let (lo, hi) = patch_height_range(&ripples, key).unwrap();
+                assert!(lo < hi, "ripples vary over a patch");
+                for sides in [0u8, 5, 15] {
+                    let mut stitch = Stitch::NONE;
+                    for (bit, side) in [(1, Side::MinU), (2, Side::MaxU), (4, Side::MinV), (8, Side::MaxV)] {
+                        if sides & bit != 0 {
+                            stitch = stitch.with_side(side);
+                        }
+                    }
+                    generate_patch(&ripples, 6.0e6, key, stitch, &mut mesh).unwrap();
+                    let low = mesh.heights.iter().copied().fold(f32::INFINITY, f32::min);
+                    let high = mesh.heights.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                    assert_eq!((low, high), (lo as f32, hi as f32), "{key:?} {sides}");
+                }
+            }
+        }
+        assert!(patch_height_range(
+            &ripples,
+            PatchKey {
+                face: Face::Top,
+                level: 1,
+                i: 2,
+                j: 0
+            }
+        )
+        .is_err());
     }
 }

@@ -13,6 +13,9 @@
 //!   planet.
 //! - [`sphere_in_frustum`], [`sphere_below_horizon`], [`occluder_radius`]: culling.
 //! - [`adjacent`]: the 26 chunks around a chunk, across face edges and cube corners.
+//! - [`ChunkRadii`], [`Selector::with_radii`], [`planet_radii`]: radial bounds tighter than a
+//!   chunk's layers where a source knows them (a height-field planet's patches, bounded by their
+//!   own heights instead of the whole relief).
 //!
 //! # The selection rule
 //!
@@ -95,6 +98,7 @@ pub mod bounds;
 mod cull;
 mod errors;
 pub mod probe;
+mod radii;
 #[cfg(test)]
 mod reference;
 mod region;
@@ -104,5 +108,6 @@ mod tree;
 pub use adjacency::{adjacent, OFFSETS};
 pub use cull::{frustum_planes, occluder_radius, sphere_below_horizon, sphere_in_frustum};
 pub use errors::{measure_level_errors, CELLS_PER_CHUNK, MIN_GRADIENT};
+pub use radii::{planet_radii, ChunkRadii, PatchRadii, MAX_KEPT_RADII, WIDE_PATCH};
 pub use region::{level_for_error, region_chunks, RegionError};
 pub use select::{LodError, LodParams, Selected, Selection, Selector, View, DEFAULT_MAX_CHUNKS, MAX_KEPT_CAPS};

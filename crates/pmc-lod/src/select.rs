@@ -4,12 +4,13 @@
 
 use crate::bounds::{cap_sphere, column_cap, layer_range, BoundingSphere, Cap};
 use crate::cull::{sphere_below_horizon, sphere_in_frustum};
+use crate::radii::ChunkRadii;
 use crate::tree::{KeyMap, Tree};
 use pmc_geometry::glam::{DVec3, DVec4};
 use pmc_geometry::{ChunkKey, Layout, SideMask};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
-use std::sync::{Mutex, PoisonError};
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// The default of [`LodParams::max_chunks`].
 pub const DEFAULT_MAX_CHUNKS: usize = 4096;
@@ -154,10 +155,14 @@ pub enum LodError {
 /// A selector keeps the bounding caps of the chunk columns its selections computed (they depend
 /// on the layout alone, and are the costly part of the bounding spheres) for the next selections,
 /// up to [`MAX_KEPT_CAPS`] of them; a clone starts without them.
+///
+/// A chunk's sphere bounds the voxel layers of its column between its depth bounds, or tighter
+/// radii where a [`ChunkRadii`] source knows them ([`Selector::with_radii`]).
 pub struct Selector {
     layout: Layout,
     errors: Vec<f64>,
     occluder: f64,
+    radii: Option<Arc<dyn ChunkRadii>>,
     caps: Mutex<KeyMap<Cap>>,
 }
 
@@ -171,15 +176,22 @@ impl Clone for Selector {
             layout: self.layout,
             errors: self.errors.clone(),
             occluder: self.occluder,
+            radii: self.radii.clone(),
             caps: Mutex::default(),
         }
     }
 }
 
 impl PartialEq for Selector {
-    /// Selectors are equal when they select the same: same layout, errors and occluder.
+    /// Selectors are equal when they select the same: same layout, errors and occluder, and
+    /// the same source of radii (or none).
     fn eq(&self, other: &Self) -> bool {
-        self.layout == other.layout && self.errors == other.errors && self.occluder == other.occluder
+        let same_radii = match (&self.radii, &other.radii) {
+            (None, None) => true,
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        };
+        self.layout == other.layout && self.errors == other.errors && self.occluder == other.occluder && same_radii
     }
 }
 
@@ -189,6 +201,7 @@ impl std::fmt::Debug for Selector {
             .field("layout", &self.layout)
             .field("errors", &self.errors)
             .field("occluder", &self.occluder)
+            .field("radii", &self.radii.is_some())
             .finish_non_exhaustive()
     }
 }
@@ -217,8 +230,18 @@ impl Selector {
             layout,
             errors,
             occluder,
+            radii: None,
             caps: Mutex::default(),
         })
+    }
+
+    /// This selector bounding chunks by the radii of `radii` where it knows them (intersected
+    /// with the chunks' layers): for a height-field planet, its patches' own heights
+    /// ([`planet_radii`](crate::planet_radii)), so that near the ground only the patches near
+    /// the eye are refined, not every patch whose column of the shell the eye is in.
+    pub fn with_radii(mut self, radii: Arc<dyn ChunkRadii>) -> Selector {
+        self.radii = Some(radii);
+        self
     }
 
     /// The layout.
@@ -243,7 +266,7 @@ impl Selector {
         let cap = params.finest_level.min(self.layout.max_level());
         // The caps kept by earlier selections; a selection running meanwhile starts without them.
         let kept = std::mem::take(&mut *self.caps.lock().unwrap_or_else(PoisonError::into_inner));
-        let mut spheres = Spheres::new(&self.layout, kept);
+        let mut spheres = Spheres::new(&self.layout, kept, self.radii.as_deref());
         let (roots, splits, mut truncated) = self.refinement(view, params, cap, &mut spheres);
         let budget = params.max_chunks;
         let mut tree = Tree::new(&self.layout);
@@ -306,6 +329,7 @@ impl Selector {
         }
         // Refine while errors[L] h / (2 tan(fov / 2) d) > max_pixel_error, without dividing.
         let scale = view.viewport_height_px / (2.0 * (0.5 * view.fov_y).tan());
+        spheres.prepare(&roots);
         let mut heap: BinaryHeap<Candidate> = roots
             .iter()
             .map(|k| Candidate {
@@ -332,6 +356,7 @@ impl Selector {
             }
             count += children.len() - 1;
             splits.push(c.key);
+            spheres.prepare(&children);
             for key in children {
                 heap.push(Candidate {
                     distance: spheres.get(&key).distance(view.eye),
@@ -405,18 +430,40 @@ struct Spheres<'a> {
     layout: &'a Layout,
     caps: KeyMap<Cap>,
     spheres: KeyMap<BoundingSphere>,
+    radii: Option<&'a dyn ChunkRadii>,
+    /// The radii of the chunks prepared and not yet bounded.
+    prepared: KeyMap<Option<(f64, f64)>>,
 }
 
 impl<'a> Spheres<'a> {
-    fn new(layout: &'a Layout, caps: KeyMap<Cap>) -> Self {
+    fn new(layout: &'a Layout, caps: KeyMap<Cap>, radii: Option<&'a dyn ChunkRadii>) -> Self {
         Spheres {
             layout,
             caps,
             spheres: KeyMap::default(),
+            radii,
+            prepared: KeyMap::default(),
         }
     }
 
-    /// [`chunk_sphere`](crate::bounds::chunk_sphere) of `key`.
+    /// Asks the radii source (if any) for the chunks of `keys` not yet bounded, all at once (a
+    /// source may compute them in parallel).
+    fn prepare(&mut self, keys: &[ChunkKey]) {
+        let Some(radii) = self.radii else {
+            return;
+        };
+        let keys: Vec<ChunkKey> = keys
+            .iter()
+            .filter(|k| !self.spheres.contains_key(k) && !self.prepared.contains_key(k))
+            .copied()
+            .collect();
+        let mut out = vec![None; keys.len()];
+        radii.radii(&keys, &mut out);
+        self.prepared.extend(keys.into_iter().zip(out));
+    }
+
+    /// [`chunk_sphere`](crate::bounds::chunk_sphere) of `key`, between the radii of the source
+    /// where it has them.
     fn get(&mut self, key: &ChunkKey) -> BoundingSphere {
         if let Some(s) = self.spheres.get(key) {
             return *s;
@@ -427,7 +474,23 @@ impl<'a> Spheres<'a> {
             .caps
             .entry(column)
             .or_insert_with(|| column_cap(layout, key.face, key.level, key.i, key.j));
-        let (r0, r1) = layer_range(layout, key.level, key.k);
+        let (mut r0, mut r1) = layer_range(layout, key.level, key.k);
+        let tighter = match self.prepared.remove(key) {
+            Some(r) => r,
+            None => self.radii.and_then(|radii| {
+                let mut out = [None];
+                radii.radii(std::slice::from_ref(key), &mut out);
+                out[0]
+            }),
+        };
+        if let Some((a, b)) = tighter {
+            // Within the layers (a sound source never says otherwise; a range outside them
+            // keeps the layers').
+            let (lo, hi) = (r0.max(a), r1.min(b));
+            if lo <= hi {
+                (r0, r1) = (lo, hi);
+            }
+        }
         let sphere = cap_sphere(cap, r0, r1);
         self.spheres.insert(*key, sphere);
         sphere

@@ -91,6 +91,16 @@ impl HeightfieldMode {
         PatchKey::new(key.face, self.max_patch_level - key.level, key.i, key.j).ok()
     }
 
+    /// The radii (metres from the planet's centre) between which every vertex of the mesh of
+    /// chunk `key` lies, whatever its stitching: the datum plus the least and the greatest height
+    /// of its patch's vertices ([`pmc_heightfield::patch_height_range`], the mesher's bits).
+    /// `None` when the key is no patch of this planet. Costs about a patch's heights.
+    pub fn patch_radii(&self, key: &ChunkKey) -> Option<(f64, f64)> {
+        let patch = self.patch_of(key)?;
+        let (lo, hi) = pmc_heightfield::patch_height_range(&*self.heights, patch).ok()?;
+        Some((self.datum + lo, self.datum + hi))
+    }
+
     /// The geometric error of each chunk level (index 0 the finest patches, 0 by convention as
     /// for the marching cubes): the 99th percentile, over `samples` random cells of the level, of
     /// the distance from the true surface to the drawn one at the middles of the cells' edges and

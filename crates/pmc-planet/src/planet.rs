@@ -205,6 +205,11 @@ impl Planet {
         self.heightfield.as_deref()
     }
 
+    /// The height-field meshing, shared (for what outlives a borrow of the planet).
+    pub fn heightfield_shared(&self) -> Option<Arc<HeightfieldMode>> {
+        self.heightfield.clone()
+    }
+
     /// This planet with a cache of the terrain's base density batches for up to `max_chunks`
     /// chunks (when full, batches used again are kept over batches used once); `0` turns caching
     /// off (the default).

@@ -156,7 +156,11 @@ pub async fn fly(state: &AppState, stops: &[Stop], camera: &FlightCamera) -> Res
         reason,
     })?;
     let errors = state.lod_errors(id, planet.clone()).await;
-    let selector = Selector::new(*planet.layout(), errors.to_vec(), pmc_lod::occluder_radius(&planet))?;
+    let mut selector = Selector::new(*planet.layout(), errors.to_vec(), pmc_lod::occluder_radius(&planet))?;
+    // A height-field planet's patches are bounded by their own heights, not the whole relief.
+    if let Some(radii) = pmc_lod::planet_radii(&planet) {
+        selector = selector.with_radii(radii);
+    }
     let router = crate::router(state.clone());
     let datum = planet.datum_radius();
     let mut reports = Vec::with_capacity(stops.len());
