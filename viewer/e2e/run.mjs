@@ -23,6 +23,7 @@
 //   PMC_E2E_LANES=1 one step after the other (by default steps 10, 11, 14 and 15, over true-scale
 //                   planets, run in a second browser beside the others; the soak, step 18, runs
 //                   last and alone)
+//   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
 //
 // The harness is harness.mjs (settings, log, clean-ups, steps), servers.mjs (pmc serve, the front
 // server, the mock) and browser.mjs (Chromium, its page and the helpers the steps use); each step

@@ -36,6 +36,9 @@ export async function startPmcServe(layout, { world = null, extra = [], port = 0
   if (layout) args.push('--n-c', String(layout.n_c), '--n-t', String(layout.n_t));
   if (world) args.push('--world', world);
   args.push(...extra);
+  // PMC_E2E_SERVE_ARGS: more options for every `pmc serve` (e.g. `--cache-mb 16`, to run the
+  // steps under a small cache while hunting a stall)
+  if (process.env.PMC_E2E_SERVE_ARGS) args.push(...process.env.PMC_E2E_SERVE_ARGS.split(/\s+/).filter(Boolean));
   log(`starting ${PMC_BIN} ${args.join(' ')}`);
   const child = spawn(PMC_BIN, args, { stdio: ['ignore', 'pipe', 'pipe'] });
   let output = '';

@@ -19,7 +19,8 @@
 //!
 //! # The selection rule
 //!
-//! Inputs: the layout, each chunk's bounding sphere ([`bounds::chunk_sphere`]), the error table
+//! Inputs: the layout, each chunk's bounding sphere ([`bounds::chunk_sphere`], or between the
+//! tighter radii of a [`ChunkRadii`] source), the error table
 //! `errors[L]` in metres, the radius `R` of a ball that is solid at every level (the occluder), a
 //! [`View`] (eye `E`, optional frustum, viewport height `h` in pixels, vertical field of view
 //! `fov`) and [`LodParams`] (pixel error bound `tau`, finest level `L_min`, budget `max_chunks`).

@@ -292,8 +292,12 @@ impl Selector {
             }
             tree = best;
         }
-        let chunks = tree
-            .leaves()
+        let leaves = tree.leaves();
+        // (the leaves the balance made were never refinement candidates: their radii at once)
+        if self.radii.is_some() {
+            spheres.prepare(&leaves.iter().map(|(key, _)| *key).collect::<Vec<_>>());
+        }
+        let chunks = leaves
             .into_iter()
             .map(|(key, node)| {
                 let sphere = spheres.get(&key);
