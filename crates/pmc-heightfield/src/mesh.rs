@@ -179,15 +179,7 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
     SCRATCH.with(|scratch| {
         let mut scratch = scratch.borrow_mut();
         let Scratch { lattice, hs, pos } = &mut *scratch;
-        fill_lattice(key, lattice);
-        hs.resize(lattice.len(), 0.0);
-        let grid = FaceGrid {
-            face: key.face,
-            i0: SEG * i64::from(key.i) - 1,
-            j0: SEG * i64::from(key.j) - 1,
-            side: GRID,
-        };
-        heights.heights_on_grid(&grid, lattice, m as i32, hs);
+        grid_heights(heights, key, lattice, hs);
         fill_positions(key, lattice, hs, radius, m, pos);
         let samples = Samples {
             heights,
@@ -211,19 +203,10 @@ pub fn generate_patch<H: LatticeHeights + ?Sized>(
 /// Refuses keys that [`PatchKey::validate`] refuses.
 pub fn patch_height_range<H: LatticeHeights + ?Sized>(heights: &H, key: PatchKey) -> Result<(f64, f64), PatchError> {
     key.validate()?;
-    let m = key.resolution();
     Ok(SCRATCH.with(|scratch| {
         let mut scratch = scratch.borrow_mut();
         let Scratch { lattice, hs, .. } = &mut *scratch;
-        fill_lattice(key, lattice);
-        hs.resize(lattice.len(), 0.0);
-        let grid = FaceGrid {
-            face: key.face,
-            i0: SEG * i64::from(key.i) - 1,
-            j0: SEG * i64::from(key.j) - 1,
-            side: GRID,
-        };
-        heights.heights_on_grid(&grid, lattice, m as i32, hs);
+        grid_heights(heights, key, lattice, hs);
         hs.chunks_exact(GRID)
             .skip(1)
             .take(SIDE)
@@ -232,6 +215,20 @@ pub fn patch_height_range<H: LatticeHeights + ?Sized>(heights: &H, key: PatchKey
                 (lo.min(h), hi.max(h))
             })
     }))
+}
+
+/// The lattice points of patch `key`'s 67 × 67 sample grid (its vertices and the one-sample
+/// border) into `lattice`, and their heights into `hs`.
+fn grid_heights<H: LatticeHeights + ?Sized>(heights: &H, key: PatchKey, lattice: &mut Vec<IVec3>, hs: &mut Vec<f64>) {
+    fill_lattice(key, lattice);
+    hs.resize(lattice.len(), 0.0);
+    let grid = FaceGrid {
+        face: key.face,
+        i0: SEG * i64::from(key.i) - 1,
+        j0: SEG * i64::from(key.j) - 1,
+        side: GRID,
+    };
+    heights.heights_on_grid(&grid, lattice, key.resolution() as i32, hs);
 }
 
 /// The positions of the sample grid, `lattice_direction(p, m) * (radius + h)` with the same bits:
