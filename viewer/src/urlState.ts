@@ -18,6 +18,8 @@ export interface UrlState {
   /** The detail settings: the largest screen-space error (pixels) and the chunk budget. */
   px?: number;
   chunks?: number;
+  /** Antialiasing (multisampling) off when false; on when absent. */
+  aa?: boolean;
 }
 
 const NUMBER_KEYS = ['lat', 'lon', 'alt', 'heading', 'pitch'] as const;
@@ -44,6 +46,9 @@ export function parseHash(hash: string): UrlState {
   if (Number.isFinite(px) && px >= 0.1 && px <= 100) out.px = px;
   const chunks = Number(params.get('chunks') ?? NaN);
   if (Number.isInteger(chunks) && chunks >= 1 && chunks <= 1_000_000) out.chunks = chunks;
+  const aa = params.get('aa');
+  if (aa === '0' || aa === 'false' || aa === 'off') out.aa = false;
+  else if (aa === '1' || aa === 'true' || aa === 'on') out.aa = true;
   return out;
 }
 
@@ -65,5 +70,6 @@ export function formatHash(s: UrlState): string {
   if (s.pitch !== undefined) params.set('pitch', fmt(s.pitch, 1));
   if (s.px !== undefined) params.set('px', fmt(s.px, 2));
   if (s.chunks !== undefined) params.set('chunks', String(Math.round(s.chunks)));
+  if (s.aa === false) params.set('aa', '0');
   return `#${params.toString()}`;
 }

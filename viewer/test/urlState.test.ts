@@ -30,3 +30,17 @@ describe('the detail settings in the URL', () => {
     expect(parseHash('#px=1000&chunks=1e9')).toEqual({});
   });
 });
+
+describe('antialiasing in the URL', () => {
+  it('is kept in the link only when off, and read in a few spellings', () => {
+    expect(formatHash({ preset: 'earth' })).not.toContain('aa=');
+    expect(formatHash({ preset: 'earth', aa: true })).not.toContain('aa=');
+    const off = formatHash({ preset: 'earth', aa: false });
+    expect(off).toContain('aa=0');
+    expect(parseHash(off).aa).toBe(false);
+    for (const v of ['0', 'false', 'off']) expect(parseHash(`#aa=${v}`).aa).toBe(false);
+    for (const v of ['1', 'true', 'on']) expect(parseHash(`#aa=${v}`).aa).toBe(true);
+    expect(parseHash('#aa=maybe').aa).toBeUndefined();
+    expect(parseHash('#lat=1').aa).toBeUndefined();
+  });
+});

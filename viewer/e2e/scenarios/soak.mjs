@@ -6,6 +6,7 @@
 // selection's chunks exactly shown, nothing pending), and no view may wait longer than three times
 // the median of its kind on its planet (a stalled view shows as one far past the others). Where a
 // view does not converge, the viewer's streaming state and the server's job table are printed.
+// The page is loaded with `#aa=0` (no antialiasing): the soak times streaming, not the renderer.
 
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -54,8 +55,12 @@ function places(seed, n) {
 /** Runs the teleports over the planet `server` serves; returns the views' times by kind. */
 async function soak(t, label, server, seed) {
   const { page, hook } = t;
-  await page.goto(`${server.url}#mode=fly&lat=0&lon=0&alt=12000000&pitch=-90`, { waitUntil: 'load', timeout: 60_000 });
+  // without antialiasing (`aa=0`, which the link keeps): the soak times the streaming, and under
+  // the software renderer multisampling about doubles every frame's cost
+  await page.goto(`${server.url}#mode=fly&lat=0&lon=0&alt=12000000&pitch=-90&aa=0`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+  const attributes = await page.evaluate(() => document.querySelector('canvas').getContext('webgl2').getContextAttributes());
+  check(attributes.antialias === false, `${label}: #aa=0 in the link gives a context without antialiasing (${JSON.stringify(attributes)})`);
   await hook((ms) => window.__pmc.ready(ms), VIEW_MS);
   /** Waits for the view to converge; on a stall, says what the page and the server were doing. */
   const converge = async (what) => {
