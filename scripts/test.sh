@@ -62,11 +62,18 @@ step "viewer: build (embedded into pmc by the next step)"
 (cd viewer && npm run --silent build)
 
 step "cargo test"
-cargo test --workspace --locked 2>&1 | tee target/cargo-test.log
+# pmc-bench holds the criterion benchmarks alone (no test; clippy above checks and lints them):
+# leaving it out of the test build spares compiling criterion and the reference crates the
+# benchmarks compare with (about a minute of one core).
+cargo test --workspace --exclude pmc-bench --locked 2>&1 | tee target/cargo-test.log
 # The pmc binary the CLI's tests ran, built by `cargo test` with the test profile (optimised,
 # viewer/dist embedded): the exports and the end-to-end tests below use it too, so the suite
-# compiles the workspace once, not a second time for a release build.
-PMC=target/debug/pmc
+# compiles the workspace once, not a second time for a release build. Cargo's own
+# CARGO_TARGET_DIR is followed (a build directory shared between checkouts keeps the
+# dependencies compiled).
+TARGET_DIR="${CARGO_TARGET_DIR:-target}"
+case "$TARGET_DIR" in /*) ;; *) TARGET_DIR="$PWD/$TARGET_DIR" ;; esac
+PMC="$TARGET_DIR/debug/pmc"
 
 if [ "$QUICK" = 1 ]; then
   step "quick mode: exports, external validators and the end-to-end tests not run"
@@ -94,7 +101,7 @@ python3 tools/check_mesh.py "$OUT/sphere.ply" --expect-euler 2 --expect-volume "
 python3 tools/check_mesh.py "$OUT/earthlike.ply"
 
 step "viewer: end-to-end tests in headless Chromium against pmc serve"
-(cd viewer && PMC_BIN="$PWD/../$PMC" node e2e/run.mjs 2>&1) | tee target/e2e.log
+(cd viewer && PMC_BIN="$PMC" node e2e/run.mjs 2>&1) | tee target/e2e.log
 
 step "all checks passed"
 # One closing line: the Rust suite's totals plus the external checks above (the validator run

@@ -5,6 +5,7 @@
 //
 //   PMC_BIN=target/debug/pmc node e2e/drawCost.mjs [draws per view, default 5]
 //   PMC_DRAW_VIEWS='100 m,2 m'  only these views
+//   PMC_DRAW_DEBUG='{"backfaces":true,"plain":true}'  with these debug flags (the test modes)
 
 import { openBrowser } from './browser.mjs';
 import { cleanup, log } from './harness.mjs';
@@ -23,6 +24,7 @@ try {
   const server = await startBackend(null, { extra: ['--preset', 'earth'] });
   await page.goto(`${server.url}#mode=fly&lat=39&lon=0&alt=12000000&pitch=-90`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
+  if (process.env.PMC_DRAW_DEBUG) await hook((f) => window.__pmc.debug(f), JSON.parse(process.env.PMC_DRAW_DEBUG));
   for (const [label, lat, lon, alt, heading, pitch] of VIEWS.filter(([l]) => !process.env.PMC_DRAW_VIEWS || process.env.PMC_DRAW_VIEWS.split(',').includes(l))) {
     await hook((v) => window.__pmc.setCamera(...v), [lat, lon, alt, heading, pitch]);
     await hook((ms) => window.__pmc.ready(ms), 300_000);

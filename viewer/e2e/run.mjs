@@ -21,8 +21,8 @@
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
 //   PMC_E2E_LANES=1 one step after the other (by default steps 10, 11, 14 and 15, over true-scale
-//                   planets, run in a second browser beside the others; the soak, step 18, runs
-//                   last and alone)
+//                   planets, and 9 run in a second browser beside the others; the soak, step 18,
+//                   runs last and alone)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
 //
 // The harness is harness.mjs (settings, log, clean-ups, steps), servers.mjs (pmc serve, the front
@@ -66,12 +66,13 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
  */
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
 /** Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API). */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, lodDefault, sky, imagery, overlays];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays];
 /**
- * The steps over true-scale planets (the earth preset, an elevation model), each with servers of
- * its own: run in a second browser beside the others (PMC_E2E_LANES, by default 2).
+ * The steps over true-scale planets (the earth preset, an elevation model), and the default
+ * planet's levels of detail, each with servers of its own: run in a second browser beside the
+ * others (PMC_E2E_LANES, by default 2), the two lanes of about the same length.
  */
-const SECOND_LANE = [lodEarth, elevationModel, levelSwitch, seaByData];
+const SECOND_LANE = [lodEarth, elevationModel, levelSwitch, seaByData, lodDefault];
 /** Then, alone on the machine (it compares the times of its views): the soak. */
 const LAST = [soak];
 const LANES = Number(process.env.PMC_E2E_LANES ?? 2);

@@ -55,6 +55,12 @@ export interface DebugFlags {
    * back face can be seen, so a magenta pixel is a crack or a hole.
    */
   backfaces: boolean;
+  /**
+   * Test mode: the ground in one colour lit by the sun, without its materials and noises (the
+   * same geometry and depth). For pictures that check the geometry (cracks and holes with
+   * `backfaces`): under a software renderer the full shading is most of a frame's cost.
+   */
+  plain: boolean;
   /** Sun and sky light and haze (off, test mode: the ground's colour alone, the same at every level). */
   lighting: boolean;
   /** The sea: water where the ground is below the datum, and the sea disk (off, test mode: neither). */
@@ -126,6 +132,7 @@ export class PlanetScene {
     faceColours: false,
     borders: false,
     backfaces: false,
+    plain: false,
     lighting: true,
     sea: true,
   };
@@ -386,6 +393,7 @@ export class PlanetScene {
       stencilZPass: THREE.ReplaceStencilOp,
       // with the back-face flag on, faces seen from inside the solid are drawn (in magenta)
       side: this.flags.backfaces ? THREE.DoubleSide : THREE.FrontSide,
+      defines: plainDefines(this.flags.plain),
     });
     if (this.flags.borders) {
       material.polygonOffset = true;
@@ -471,6 +479,7 @@ export class PlanetScene {
       const m = obj.mesh.material;
       m.wireframe = next.wireframe;
       m.side = next.backfaces ? THREE.DoubleSide : THREE.FrontSide;
+      m.defines = plainDefines(next.plain);
       m.polygonOffset = next.borders;
       m.polygonOffsetFactor = 1;
       m.polygonOffsetUnits = 1;
@@ -657,4 +666,9 @@ export class PlanetScene {
 function placeChunk(obj: ChunkObject, camera: V3, rel: V3 = [0, 0, 0]): void {
   relativeToCamera(obj.origin, camera, rel);
   obj.mesh.position.set(rel[0], rel[1], rel[2]);
+}
+
+/** The terrain material's defines: `PMC_PLAIN` draws the ground in one lit colour (`DebugFlags.plain`). */
+function plainDefines(plain: boolean): Record<string, string> {
+  return plain ? { PMC_PLAIN: '' } : {};
 }

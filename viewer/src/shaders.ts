@@ -378,6 +378,11 @@ void main() {
     return;
   }
   vec3 n = normalize(vNormal);
+  #ifdef PMC_PLAIN
+  // test mode (a program of its own): a grey green lit by the sun, never the back faces'
+  // magenta, a sky's or the test background's colour
+  gl_FragColor = vec4(vec3(0.42, 0.5, 0.38) * (0.45 + 0.55 * max(dot(n, uSunDir), 0.0)), 1.0);
+  #else
   vec3 up = normalize(vUp);
   float slope = dot(n, up);
   // (the imagery's rock on steep ground goes by the mesh's slope: the relief's, at full weight
@@ -474,6 +479,7 @@ void main() {
   vec3 pmcColour = pmcAerialPerspective(lit, seen);
   gl_FragColor = vec4(pmcColour, 1.0);
   #include <colorspace_fragment>
+  #endif
 }
 `;
 

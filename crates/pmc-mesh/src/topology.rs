@@ -75,7 +75,10 @@ impl WeldedMesh {
 
     /// Counts boundary and non-manifold edges.
     pub fn report(&self) -> ManifoldReport {
-        let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(self.triangles.len() * 3);
+        // Every directed edge as (undirected pair, direction), sorted: the directed edges of one
+        // undirected edge lie together, and each is counted against its reverse (a sort instead
+        // of a hash map: meshes of millions of triangles are checked in tests and exports).
+        let mut directed: Vec<(u64, bool)> = Vec::with_capacity(self.triangles.len() * 3);
         let mut collapsed = 0;
         let mut used = vec![false; self.positions.len()];
         for t in &self.triangles {
@@ -83,21 +86,45 @@ impl WeldedMesh {
                 collapsed += 1;
             }
             for k in 0..3 {
-                used[t[k] as usize] = true;
-                *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                used[a as usize] = true;
+                directed.push(((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), a > b));
             }
         }
+        directed.sort_unstable();
         let (mut edges, mut boundary, mut bad) = (0, 0, 0);
-        for (&(a, b), &n) in &directed {
-            let back = directed.get(&(b, a)).copied().unwrap_or(0);
-            if a < b || back == 0 {
-                edges += 1;
+        let mut i = 0;
+        while i < directed.len() {
+            let pair = directed[i].0;
+            let mut j = i;
+            while j < directed.len() && directed[j].0 == pair {
+                j += 1;
             }
-            if n > 1 || back > 1 {
-                bad += 1;
-            } else if back == 0 {
-                boundary += 1;
+            // triangles using the edge from its lower vertex to its higher, and the reverse
+            let up = directed[i..j].iter().filter(|e| !e.1).count();
+            let down = j - i - up;
+            if (pair >> 32) as u32 == pair as u32 {
+                // a collapsed triangle's edge from a vertex to itself: its own reverse
+                if up > 1 {
+                    bad += 1;
+                }
+            } else {
+                if up > 0 || down > 0 {
+                    edges += 1;
+                }
+                // each direction used, against the other
+                for (n, back) in [(up, down), (down, up)] {
+                    if n == 0 {
+                        continue;
+                    }
+                    if n > 1 || back > 1 {
+                        bad += 1;
+                    } else if back == 0 {
+                        boundary += 1;
+                    }
+                }
             }
+            i = j;
         }
         ManifoldReport {
             vertices: used.iter().filter(|u| **u).count(),
@@ -123,5 +150,100 @@ impl WeldedMesh {
                 a.dot(b.cross(d)) / 6.0
             })
             .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The report as first written: a hash map of directed edges, each counted against its
+    /// reverse. The sorted count must give the same numbers for any triangle soup.
+    fn reference(mesh: &WeldedMesh) -> ManifoldReport {
+        let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut collapsed = 0;
+        let mut used = vec![false; mesh.positions.len()];
+        for t in &mesh.triangles {
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                collapsed += 1;
+            }
+            for k in 0..3 {
+                used[t[k] as usize] = true;
+                *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+            }
+        }
+        let (mut edges, mut boundary, mut bad) = (0, 0, 0);
+        for (&(a, b), &n) in &directed {
+            let back = directed.get(&(b, a)).copied().unwrap_or(0);
+            if a < b || back == 0 {
+                edges += 1;
+            }
+            if n > 1 || back > 1 {
+                bad += 1;
+            } else if back == 0 {
+                boundary += 1;
+            }
+        }
+        ManifoldReport {
+            vertices: used.iter().filter(|u| **u).count(),
+            edges,
+            triangles: mesh.triangles.len(),
+            boundary_edges: boundary,
+            bad_edges: bad,
+            collapsed_triangles: collapsed,
+        }
+    }
+
+    /// A closed octahedron: 6 vertices, 12 edges, 8 triangles.
+    fn octahedron() -> WeldedMesh {
+        let p = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z];
+        let triangles = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        WeldedMesh {
+            positions: p.to_vec(),
+            triangles,
+        }
+    }
+
+    #[test]
+    fn an_octahedron_is_closed_and_a_missing_or_turned_face_is_found() {
+        let mut m = octahedron();
+        let r = m.report();
+        assert!(r.is_closed_manifold(), "{r:?}");
+        assert_eq!(
+            (r.vertices, r.edges, r.triangles, r.euler_characteristic()),
+            (6, 12, 8, 2)
+        );
+        m.triangles.pop();
+        let r = m.report();
+        assert_eq!((r.boundary_edges, r.bad_edges), (3, 0), "{r:?}");
+        assert_eq!(r, reference(&m));
+        // a face turned over: each of its three edges runs the same way as its neighbour's
+        let mut m = octahedron();
+        m.triangles[0].swap(1, 2);
+        let r = m.report();
+        assert_eq!((r.boundary_edges, r.bad_edges), (0, 3), "{r:?}");
+        assert_eq!(r, reference(&m));
+    }
+
+    proptest! {
+        /// Any soup of triangles over a few vertices (repeated, turned over, collapsed): the
+        /// sorted count gives the reference's numbers.
+        #[test]
+        fn the_sorted_count_equals_the_hash_map_count(
+            triangles in proptest::collection::vec([0u32..7, 0u32..7, 0u32..7], 0..40),
+        ) {
+            let mesh = WeldedMesh { positions: vec![DVec3::ZERO; 7], triangles };
+            prop_assert_eq!(mesh.report(), reference(&mesh));
+        }
     }
 }

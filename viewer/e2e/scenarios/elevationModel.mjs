@@ -95,7 +95,8 @@ export async function scenario(t) {
   }
   /** The view from (lat, lon) `height` m above the datum looking `pitch` degrees: no flagged pixel (no crack, no hole); a picture as a user sees it. */
   const look = async (name, lat, lon, height, pitch) => {
-    await hook(() => window.__pmc.debug({ backfaces: true }));
+    // (the flagged picture in one lit colour: see lodFlight.mjs)
+    await hook(() => window.__pmc.debug({ backfaces: true, plain: true }));
     await hook(([a, b, h, p]) => window.__pmc.setCamera(a, b, h, 0, p), [lat, lon, height, pitch]);
     const st = await ready(name);
     const flaggedImg = await shot(`${name}-flagged`);
@@ -104,7 +105,7 @@ export async function scenario(t) {
     log(`  ${name}: ${st.shown} chunks shown, levels ${st.lod.levelsText}, ${flagged} flagged pixels, ${tinted} tinted`);
     check(flagged === 0, `${name}: ${flagged} flagged pixels (a crack or a hole): see ${name}-flagged.png`);
     check(tinted <= TINTED_ALLOWED, `${name}: ${tinted} pixels tinted by the back-face flag: see ${name}-flagged.png`);
-    await hook(() => window.__pmc.debug({ backfaces: false }));
+    await hook(() => window.__pmc.debug({ backfaces: false, plain: false }));
     return shot(`${name}-view`);
   };
   /** The meshed ground at (lat, lon), metres above the datum, and its point (planet frame), from `pmc dem probe`. */

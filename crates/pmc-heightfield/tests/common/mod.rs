@@ -6,7 +6,6 @@ use pmc_geometry::glam::{DVec3, IVec3};
 use pmc_geometry::EdgeKey;
 use pmc_heightfield::{lattice_direction, ConstantHeight, LatticeHeights, Ripples};
 use pmc_mesh::ChunkMesh;
-use std::collections::HashMap;
 
 /// Fractal noise of the direction: `amplitude * fbm(direction)`, scale-invariant.
 pub struct FbmHeights {
@@ -73,22 +72,25 @@ pub fn used(mesh: &ChunkMesh) -> Vec<bool> {
 }
 
 /// Largest normal deviation among co-located used vertices, and how many keys are shared.
+/// (Sorted by key, the copies of a vertex in mesh order: a sort, not a hash map, for the
+/// millions of vertices of a view.)
 pub fn normal_spread(meshes: &[ChunkMesh]) -> (f64, usize) {
-    let mut by_key: HashMap<EdgeKey, Vec<[f32; 3]>> = HashMap::new();
+    let mut copies: Vec<(EdgeKey, [f32; 3])> = Vec::new();
     for m in meshes {
         for (v, u) in used(m).into_iter().enumerate() {
             if u {
-                by_key.entry(m.edge_keys[v]).or_default().push(m.normals[v]);
+                copies.push((m.edge_keys[v], m.normals[v]));
             }
         }
     }
+    copies.sort_by_key(|c| c.0);
     let mut worst: f64 = 0.0;
     let mut shared = 0;
-    for ns in by_key.values().filter(|n| n.len() > 1) {
+    for ns in copies.chunk_by(|a, b| a.0 == b.0).filter(|n| n.len() > 1) {
         shared += 1;
-        let a = DVec3::from(ns[0].map(f64::from));
+        let a = DVec3::from(ns[0].1.map(f64::from));
         for n in &ns[1..] {
-            worst = worst.max((DVec3::from(n.map(f64::from)) - a).length());
+            worst = worst.max((DVec3::from(n.1.map(f64::from)) - a).length());
         }
     }
     (worst, shared)
@@ -121,17 +123,17 @@ impl Closure {
 /// Welds the meshes by `edge_keys` (the lattice identity) and counts every undirected edge's
 /// triangles: a closed 2-manifold has each edge in exactly two, in opposite directions.
 pub fn closure(meshes: &[ChunkMesh]) -> Closure {
-    let mut ids: HashMap<u128, u32> = HashMap::new();
+    // the welded vertices: every distinct key, sorted (its index is its id)
+    let mut keys: Vec<u128> = meshes.iter().flat_map(|m| m.edge_keys.iter().map(|k| k.0)).collect();
+    keys.sort_unstable();
+    keys.dedup();
     let mut edges: Vec<(u64, bool)> = Vec::new();
     let mut c = Closure::default();
     for m in meshes {
         let local: Vec<u32> = m
             .edge_keys
             .iter()
-            .map(|k| {
-                let n = ids.len() as u32;
-                *ids.entry(k.0).or_insert(n)
-            })
+            .map(|k| keys.binary_search(&k.0).expect("every key was collected") as u32)
             .collect();
         for t in m.indices.chunks_exact(3) {
             let v = [local[t[0] as usize], local[t[1] as usize], local[t[2] as usize]];
@@ -146,8 +148,12 @@ pub fn closure(meshes: &[ChunkMesh]) -> Closure {
         }
     }
     edges.sort_unstable();
-    let used: std::collections::HashSet<u32> = edges.iter().flat_map(|e| [(e.0 >> 32) as u32, e.0 as u32]).collect();
-    c.vertices = used.len();
+    let mut used = vec![false; keys.len()];
+    for e in &edges {
+        used[(e.0 >> 32) as usize] = true;
+        used[e.0 as u32 as usize] = true;
+    }
+    c.vertices = used.iter().filter(|u| **u).count();
     for group in edges.chunk_by(|a, b| a.0 == b.0) {
         c.edges += 1;
         match group {
