@@ -17,7 +17,9 @@ for arg in "$@"; do
   esac
 done
 
-step() { printf '\n==> %s\n' "$*"; }
+# Each step says when it starts, counted from the start of the suite (bash's SECONDS).
+elapsed() { printf '%d min %02d s' $((SECONDS / 60)) $((SECONDS % 60)); }
+step() { printf '\n==> %s (at %s)\n' "$*" "$(elapsed)"; }
 
 step "install external validators"
 if [ ! -d tools/gltf-validate/node_modules/gltf-validator ]; then
