@@ -11,6 +11,11 @@
 // 2 m: 8.9 s against 1.0 s). The pictures as users see them (`pictures`) and the two of the still
 // camera (`jitter`: the noises are where an imprecise position shows first) are fully shaded.
 
+/** The debug flags of the flagged pictures: back faces in the flag colour, the ground plain. */
+export const FLAGGED = { backfaces: true, plain: true };
+/** The debug flags of the pictures as users see them. */
+export const AS_SEEN = { backfaces: false, plain: false };
+
 /**
  * Pixels the back-face flag colour (#ff00ff) tints: red and blue both over green by more than 20
  * (no colour of the terrain, the sea or the sky of the test mode is so), so a gap that shows the
@@ -88,7 +93,7 @@ export function levelRange(levels) {
  */
 export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures = false, jitter = 0 }) {
   const { hook, ready, shot, log, check } = t;
-  await hook(() => window.__pmc.debug({ backfaces: true, plain: true }));
+  await hook((f) => window.__pmc.debug(f), FLAGGED);
   const seen = [];
   // the ground under the place, from the meshes loaded around it: refined at every stop
   let ground = null;
@@ -189,9 +194,9 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
       );
     }
     if (pictures) {
-      await hook(() => window.__pmc.debug({ backfaces: false, plain: false }));
+      await hook((f) => window.__pmc.debug(f), AS_SEEN);
       await shot(`${label}-${stop.name}-view`);
-      await hook(() => window.__pmc.debug({ backfaces: true, plain: true }));
+      await hook((f) => window.__pmc.debug(f), FLAGGED);
     }
     const p = t.problems();
     check(p.length === 0, `${label} ${stop.name}: ${p.join('\n  ')}`);
@@ -253,6 +258,6 @@ export async function lodFlight(t, { label, lat, lon, stops, zoom = [], pictures
       seen.push(await visit(stop, n === 0 ? 0 : 4));
     }
   }
-  await hook(() => window.__pmc.debug({ backfaces: false, plain: false }));
+  await hook((f) => window.__pmc.debug(f), AS_SEEN);
   return seen;
 }

@@ -93,38 +93,30 @@ impl WeldedMesh {
         }
         directed.sort_unstable();
         let (mut edges, mut boundary, mut bad) = (0, 0, 0);
-        let mut i = 0;
-        while i < directed.len() {
-            let pair = directed[i].0;
-            let mut j = i;
-            while j < directed.len() && directed[j].0 == pair {
-                j += 1;
-            }
+        for group in directed.chunk_by(|x, y| x.0 == y.0) {
+            let pair = group[0].0;
             // triangles using the edge from its lower vertex to its higher, and the reverse
-            let up = directed[i..j].iter().filter(|e| !e.1).count();
-            let down = j - i - up;
+            let up = group.iter().filter(|e| !e.1).count();
+            let down = group.len() - up;
             if (pair >> 32) as u32 == pair as u32 {
                 // a collapsed triangle's edge from a vertex to itself: its own reverse
                 if up > 1 {
                     bad += 1;
                 }
-            } else {
-                if up > 0 || down > 0 {
-                    edges += 1;
+                continue;
+            }
+            edges += 1;
+            // each direction used, against the other
+            for (n, back) in [(up, down), (down, up)] {
+                if n == 0 {
+                    continue;
                 }
-                // each direction used, against the other
-                for (n, back) in [(up, down), (down, up)] {
-                    if n == 0 {
-                        continue;
-                    }
-                    if n > 1 || back > 1 {
-                        bad += 1;
-                    } else if back == 0 {
-                        boundary += 1;
-                    }
+                if n > 1 || back > 1 {
+                    bad += 1;
+                } else if back == 0 {
+                    boundary += 1;
                 }
             }
-            i = j;
         }
         ManifoldReport {
             vertices: used.iter().filter(|u| **u).count(),

@@ -7,7 +7,7 @@ import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { DEM_SOURCE, PMC_BIN, VIEWPORT, check, cleanups, log, run } from '../harness.mjs';
 import { crop, fractionDifferent } from '../images.mjs';
-import { TINTED_ALLOWED, flaggedPixels, tintedPixels } from '../lodFlight.mjs';
+import { AS_SEEN, FLAGGED, TINTED_ALLOWED, flaggedPixels, tintedPixels } from '../lodFlight.mjs';
 import { startBackend } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
 
@@ -95,8 +95,7 @@ export async function scenario(t) {
   }
   /** The view from (lat, lon) `height` m above the datum looking `pitch` degrees: no flagged pixel (no crack, no hole); a picture as a user sees it. */
   const look = async (name, lat, lon, height, pitch) => {
-    // (the flagged picture in one lit colour: see lodFlight.mjs)
-    await hook(() => window.__pmc.debug({ backfaces: true, plain: true }));
+    await hook((f) => window.__pmc.debug(f), FLAGGED);
     await hook(([a, b, h, p]) => window.__pmc.setCamera(a, b, h, 0, p), [lat, lon, height, pitch]);
     const st = await ready(name);
     const flaggedImg = await shot(`${name}-flagged`);
@@ -105,7 +104,7 @@ export async function scenario(t) {
     log(`  ${name}: ${st.shown} chunks shown, levels ${st.lod.levelsText}, ${flagged} flagged pixels, ${tinted} tinted`);
     check(flagged === 0, `${name}: ${flagged} flagged pixels (a crack or a hole): see ${name}-flagged.png`);
     check(tinted <= TINTED_ALLOWED, `${name}: ${tinted} pixels tinted by the back-face flag: see ${name}-flagged.png`);
-    await hook(() => window.__pmc.debug({ backfaces: false, plain: false }));
+    await hook((f) => window.__pmc.debug(f), AS_SEEN);
     return shot(`${name}-view`);
   };
   /** The meshed ground at (lat, lon), metres above the datum, and its point (planet frame), from `pmc dem probe`. */
