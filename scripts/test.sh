@@ -54,7 +54,9 @@ step "cargo fmt --check"
 cargo fmt --all -- --check
 
 step "cargo clippy (warnings denied)"
-cargo clippy --workspace --all-targets --locked -- -D warnings
+# With the test profile, clippy and `cargo test` below share the build scripts, their outputs
+# (SQLite's C compiled once) and the procedural macros: about 50 s less on a cold build.
+cargo clippy --workspace --all-targets --locked --profile test -- -D warnings
 
 mkdir -p target
 step "viewer: type check and unit tests (vitest)"

@@ -1,7 +1,7 @@
 //! GeoTIFF files written here (strips by the `tiff` crate, tiles by hand): values, extents, the
 //! north-up flip, nodata, wrapping, windowed reads, and every refusal naming the file.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pmc_dem::{DemError, EquirectDem, EquirectSource, GeoTiffSource, MAX_CELLS};

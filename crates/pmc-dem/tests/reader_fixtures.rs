@@ -1,10 +1,10 @@
 //! The GeoTIFF and PNG fixtures that seed the fuzzer (`src/fuzz.rs`) are built here from the
 //! ETOPO60 fixture: every 5 degrees (72 x 36 pixels), as whole metres.
 //!
-//! Rebuild them with `PMC_WRITE_FIXTURES=1 cargo test -p pmc-dem --test reader_fixtures`;
+//! Rebuild them with `PMC_WRITE_FIXTURES=1 cargo test -p pmc-dem --test dem reader_fixtures::`;
 //! otherwise this test checks that the committed files are what the builders write.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pmc_dem::fuzz::{PNG_EXTENT, SEED_FILES};

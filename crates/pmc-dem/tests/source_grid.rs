@@ -3,7 +3,7 @@
 //! and PNG inputs; heights stay a pure, scale-invariant function of the place; version 1 files
 //! still open.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pmc_dem::cube::{accuracy, import_cube, CubeDem, DetailNoise, ImportOptions, Interpolation};

@@ -1,6 +1,6 @@
 //! Bad input gives errors, never panics; `export` never leaves half files behind.
 
-mod common;
+use crate::common;
 
 use common::{meta, split_box, temp_dir, OFFSETS};
 use pmc_formats::{export, write_glb, write_obj, write_ply, ExportError, ExportMeta, Format};

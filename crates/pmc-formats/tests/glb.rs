@@ -1,6 +1,6 @@
 //! GLB layout version 1: container, JSON, accessors, node transforms, sea.
 
-mod common;
+use crate::common;
 
 use common::{meta, split_box, FAR, OFFSETS};
 use gltf_json::mesh::Semantic;

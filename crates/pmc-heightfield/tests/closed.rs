@@ -1,6 +1,6 @@
 //! The union of the selected patches is one closed surface with matching normals, for random
 //! views of several planets.
-mod common;
+use crate::common;
 
 use common::{closure, normal_spread, sources, used};
 use pmc_geometry::glam::{DVec3, IVec3};

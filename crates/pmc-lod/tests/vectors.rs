@@ -2,8 +2,8 @@
 //! they give, kept in `tests/data/selection-vectors.json` so that other implementations of the
 //! rule (the viewer's) can check they select the same chunks.
 //!
-//! `PMC_BLESS=1 cargo test -p pmc-lod --test vectors` writes the file anew. The views are drawn
-//! from a fixed generator and kept only when the selection is robust: it does not change when
+//! `PMC_BLESS=1 cargo test -p pmc-lod --test lod vectors::` writes the file anew. The views are
+//! drawn from a fixed generator and kept only when the selection is robust: it does not change when
 //! the pixel error bound, the eye, the occluder and the frustum move by a relative 1e-9, so that
 //! an implementation whose `sin`, `cos`, `tan` or `atan2` differ in the last bit selects the same
 //! chunks.

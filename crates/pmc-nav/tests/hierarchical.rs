@@ -3,7 +3,7 @@
 //! walk is made of the grid's steps, its length is within a stated bound of the shortest, and
 //! after an edit it sees the change.
 
-mod common;
+use crate::common;
 
 use common::{default_grid, default_planet, Lcg};
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot, EditedDensity};

@@ -2,7 +2,7 @@
 //! top) gives the grid a fresh build of the edited density gives, node for node: the batches
 //! hold the same bits at the same points as the tile's own samples.
 
-mod common;
+use crate::common;
 
 use common::{default_grid, default_planet};
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot};

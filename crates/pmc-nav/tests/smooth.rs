@@ -3,7 +3,7 @@
 //! the smoother, passes only over columns holding a walkable node near its height with head room
 //! in air: never through a filled voxel.
 
-mod common;
+use crate::common;
 
 use common::{default_grid, leg_point};
 use pmc_density::{Density, Sphere};

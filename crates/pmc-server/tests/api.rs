@@ -1,6 +1,6 @@
 //! The endpoints of `docs/specs/http-api-v1.md`, through the router.
 
-mod common;
+use crate::common;
 
 use axum::body::Body;
 use axum::http::{Request, StatusCode};

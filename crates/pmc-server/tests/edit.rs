@@ -1,7 +1,7 @@
 //! Editing through the API (`docs/specs/http-api-v1.md`, "Editing: worlds"): the world file,
 //! the edit endpoints, their validation and limits, chunk invalidation and the server push.
 
-mod common;
+use crate::common;
 
 use axum::body::Body;
 use axum::http::{Request, StatusCode};

@@ -2,7 +2,7 @@
 //! description gives the patch layout and its errors, chunks are stitched patches, and what a
 //! height field cannot do (presets, editing, other planets) is refused with a clear message.
 
-mod common;
+use crate::common;
 
 use axum::http::StatusCode;
 use common::{app, get};

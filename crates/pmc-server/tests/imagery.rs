@@ -1,7 +1,7 @@
 //! Imagery draped on the default planet: the `imagery` field of `/api/v1/planet` and the image
 //! at `/api/v1/imagery` (docs/specs/http-api-v1.md).
 
-mod common;
+use crate::common;
 
 use axum::body::Body;
 use axum::http::{Request, StatusCode};

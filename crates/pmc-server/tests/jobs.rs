@@ -1,7 +1,7 @@
 //! Chunk jobs: requests that go away drop the jobs nobody waits for any more, priorities order
 //! the queue, and chunks of every level of detail are served and cached apart.
 
-mod common;
+use crate::common;
 
 use axum::http::StatusCode;
 use axum::Router;

@@ -1,7 +1,7 @@
 //! The navigation endpoints: `/api/v1/path` and `/api/v1/navgrid`, on plain planets and on a
 //! world whose grid follows its edits.
 
-mod common;
+use crate::common;
 
 use axum::body::Body;
 use axum::http::{Request, StatusCode};

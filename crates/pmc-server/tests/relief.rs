@@ -2,7 +2,7 @@
 //! `/api/v1/relief` (docs/specs/http-api-v1.md), from which the viewer takes the materials' heights
 //! the same at every level of detail.
 
-mod common;
+use crate::common;
 
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
