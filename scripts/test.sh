@@ -66,17 +66,22 @@ step "viewer: build (embedded into pmc by the next step)"
 (cd viewer && npm run --silent build)
 
 step "cargo test"
-# pmc-bench holds the criterion benchmarks alone (no test; clippy above checks and lints them):
-# leaving it out of the test build spares compiling criterion and the reference crates the
-# benchmarks compare with (about a minute of one core).
-cargo test --workspace --exclude pmc-bench --locked 2>&1 | tee target/cargo-test.log
-# The pmc binary the CLI's tests ran, built by `cargo test` with the test profile (optimised,
-# viewer/dist embedded): the exports and the end-to-end tests below use it too, so the suite
-# compiles the workspace once, not a second time for a release build. Cargo's own
-# CARGO_TARGET_DIR is followed (a build directory shared between checkouts keeps the
+# Cargo's own CARGO_TARGET_DIR is followed (a build directory shared between checkouts keeps the
 # dependencies compiled).
 TARGET_DIR="${CARGO_TARGET_DIR:-target}"
 case "$TARGET_DIR" in /*) ;; *) TARGET_DIR="$PWD/$TARGET_DIR" ;; esac
+# The tests' scratch files (std::env::temp_dir) go to a directory of the build's, emptied at each
+# run, rather than piling up in /tmp run after run.
+SCRATCH="$TARGET_DIR/test-scratch"
+rm -rf "$SCRATCH"
+mkdir -p "$SCRATCH"
+# pmc-bench holds the criterion benchmarks alone (no test; clippy above checks and lints them):
+# leaving it out of the test build spares compiling criterion and the reference crates the
+# benchmarks compare with (about a minute of one core).
+TMPDIR="$SCRATCH" cargo test --workspace --exclude pmc-bench --locked 2>&1 | tee target/cargo-test.log
+# The pmc binary the CLI's tests ran, built by `cargo test` with the test profile (optimised,
+# viewer/dist embedded): the exports and the end-to-end tests below use it too, so the suite
+# compiles the workspace once, not a second time for a release build.
 PMC="$TARGET_DIR/debug/pmc"
 
 if [ "$QUICK" = 1 ]; then
