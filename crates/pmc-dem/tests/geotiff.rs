@@ -1,9 +1,7 @@
 //! GeoTIFF files written here (strips by the `tiff` crate, tiles by hand): values, extents, the
 //! north-up flip, nodata, wrapping, windowed reads, and every refusal naming the file.
 
-use crate::common;
-
-use common::*;
+use crate::common::*;
 use pmc_dem::{DemError, EquirectDem, EquirectSource, GeoTiffSource, MAX_CELLS};
 use tiff::encoder::colortype::{Gray16, Gray32Float, Gray64Float, GrayI16, GrayI32};
 use tiff::encoder::{Compression, DeflateLevel};

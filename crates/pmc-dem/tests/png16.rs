@@ -1,9 +1,7 @@
 //! 16-bit grayscale PNG files written here with the `png` encoder: values, extents, the
 //! north-up flip, nodata, wrapping, and every refusal naming the file.
 
-use crate::common;
-
-use common::*;
+use crate::common::*;
 use pmc_dem::{DemError, EquirectDem, PngExtent};
 
 fn refusal(name: &str, bytes: &[u8], extent: &PngExtent) -> DemError {

@@ -4,9 +4,7 @@
 //! Rebuild them with `PMC_WRITE_FIXTURES=1 cargo test -p pmc-dem --test dem reader_fixtures::`;
 //! otherwise this test checks that the committed files are what the builders write.
 
-use crate::common;
-
-use common::*;
+use crate::common::*;
 use pmc_dem::fuzz::{PNG_EXTENT, SEED_FILES};
 use pmc_dem::{EquirectDem, EquirectSource, GeoTiffSource};
 use tiff::encoder::colortype::{Gray32Float, GrayI16};

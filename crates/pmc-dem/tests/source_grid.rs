@@ -3,9 +3,7 @@
 //! and PNG inputs; heights stay a pure, scale-invariant function of the place; version 1 files
 //! still open.
 
-use crate::common;
-
-use common::*;
+use crate::common::*;
 use pmc_dem::cube::{accuracy, import_cube, CubeDem, DetailNoise, ImportOptions, Interpolation};
 use pmc_dem::fuzz::{PNG_EXTENT, SEED_FILES};
 use pmc_dem::{DemError, EquirectDem, EquirectSource};

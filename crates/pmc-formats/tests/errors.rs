@@ -1,8 +1,6 @@
 //! Bad input gives errors, never panics; `export` never leaves half files behind.
 
-use crate::common;
-
-use common::{meta, split_box, temp_dir, OFFSETS};
+use crate::common::{meta, split_box, temp_dir, OFFSETS};
 use pmc_formats::{export, write_glb, write_obj, write_ply, ExportError, ExportMeta, Format};
 use pmc_geometry::glam::DVec3;
 use pmc_mesh::ChunkMesh;

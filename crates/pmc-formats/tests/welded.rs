@@ -1,8 +1,6 @@
 //! OBJ and PLY layout version 1: one welded, world-space, closed mesh.
 
-use crate::common;
-
-use common::{box_triangles, box_vertices, check_closed, meta, split_box, FAR, OFFSETS};
+use crate::common::{box_triangles, box_vertices, check_closed, meta, split_box, FAR, OFFSETS};
 use pmc_formats::{write_obj, write_ply, PLY_FACE_BYTES, PLY_VERTEX_BYTES};
 use pmc_geometry::glam::DVec3;
 use pmc_mesh::ChunkMesh;

@@ -1,9 +1,7 @@
 //! Single patches: the same lattice point gives the same vertex at every level, a stitched side
 //! takes the coarser neighbour's edge and normals (also across a face edge and at a cube corner),
 //! and misuse is refused with a clear message.
-use crate::common;
-
-use common::{closure, used, FbmHeights};
+use crate::common::{closure, used, FbmHeights};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{EdgeKey, Face};
 use pmc_heightfield::{

@@ -1,9 +1,7 @@
 //! The 26-neighbourhood found by stepping across sides equals the chunks that share a voxel,
 //! across face edges and next to cube corners, at every level.
 
-use crate::common;
-
-use common::{boundary_voxels, small_layouts};
+use crate::common::{boundary_voxels, small_layouts};
 use pmc_geometry::{ChunkKey, Face, Layout, VoxelKey};
 use pmc_lod::{adjacent, OFFSETS};
 use std::collections::{BTreeSet, HashMap};

@@ -2,9 +2,7 @@
 //! corners (face edges and cube corners included), no checkerboard around an edge, seam masks,
 //! culling soundness, budget and determinism.
 
-use crate::common;
-
-use common::{
+use crate::common::{
     assert_balanced, assert_coarser_masks, assert_no_checkerboard, assert_partition, leaves_covering, small_layouts,
     voxel_owners,
 };

@@ -3,9 +3,7 @@
 //! walk is made of the grid's steps, its length is within a stated bound of the shortest, and
 //! after an edit it sees the change.
 
-use crate::common;
-
-use common::{default_grid, default_planet, Lcg};
+use crate::common::{default_grid, default_planet, Lcg};
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot, EditedDensity};
 use pmc_geometry::glam::DVec3;
 use pmc_nav::{find_path, find_path_hierarchical, Agent, NavGrid, NoPath, NodeId, Path, HIERARCHICAL_WEIGHT};

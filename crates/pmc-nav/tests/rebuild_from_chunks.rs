@@ -2,9 +2,7 @@
 //! top) gives the grid a fresh build of the edited density gives, node for node: the batches
 //! hold the same bits at the same points as the tile's own samples.
 
-use crate::common;
-
-use common::{default_grid, default_planet};
+use crate::common::{default_grid, default_planet};
 use pmc_edit::{BrushKind, BrushOp, EditSnapshot};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::Layout;

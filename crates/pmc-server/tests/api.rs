@@ -1,10 +1,8 @@
 //! The endpoints of `docs/specs/http-api-v1.md`, through the router.
 
-use crate::common;
-
+use crate::common::{app, get, send, small_config, small_layout, stats};
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
-use common::{app, get, send, small_config, small_layout, stats};
 use pmc_formats::chunk_encoding::{decode_chunk, encode_chunk};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Face, Layout};

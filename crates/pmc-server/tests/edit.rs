@@ -1,12 +1,10 @@
 //! Editing through the API (`docs/specs/http-api-v1.md`, "Editing: worlds"): the world file,
 //! the edit endpoints, their validation and limits, chunk invalidation and the server push.
 
-use crate::common;
-
+use crate::common::{get, send, small_config, small_layout, stats, Reply};
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use axum::Router;
-use common::{get, send, small_config, small_layout, stats, Reply};
 use futures_util::StreamExt;
 use pmc_edit::{affected_chunks_lod, BrushKind, BrushOp};
 use pmc_formats::chunk_encoding::encode_chunk;

@@ -1,9 +1,7 @@
 //! The flight benchmark's harness: stops converge with every drawn chunk served, coarse views
 //! draw coarse levels, and flying the same stop again is answered from the cache.
 
-use crate::common;
-
-use common::small_config;
+use crate::common::small_config;
 use pmc_server::flight::{descent, fly, FlightCamera};
 use pmc_server::AppState;
 

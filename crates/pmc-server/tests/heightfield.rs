@@ -2,10 +2,8 @@
 //! description gives the patch layout and its errors, chunks are stitched patches, and what a
 //! height field cannot do (presets, editing, other planets) is refused with a clear message.
 
-use crate::common;
-
+use crate::common::{app, get};
 use axum::http::StatusCode;
-use common::{app, get};
 use pmc_dem::{import_cube, EquirectDem, ImportOptions};
 use pmc_formats::chunk_encoding::decode_chunk;
 use pmc_geometry::{ChunkKey, Face, SideMask};

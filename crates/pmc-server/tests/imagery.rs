@@ -1,11 +1,9 @@
 //! Imagery draped on the default planet: the `imagery` field of `/api/v1/planet` and the image
 //! at `/api/v1/imagery` (docs/specs/http-api-v1.md).
 
-use crate::common;
-
+use crate::common::{app, get, send, small_config};
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
-use common::{app, get, send, small_config};
 use pmc_imagery::{Extent, Imagery};
 use pmc_server::{AppState, ServerConfig, ServerError};
 use std::path::PathBuf;

@@ -1,11 +1,9 @@
 //! Chunk jobs: requests that go away drop the jobs nobody waits for any more, priorities order
 //! the queue, and chunks of every level of detail are served and cached apart.
 
-use crate::common;
-
+use crate::common::{app, get, small_config, stats, Reply};
 use axum::http::StatusCode;
 use axum::Router;
-use common::{app, get, small_config, stats, Reply};
 use pmc_density::Density;
 use pmc_formats::chunk_encoding::{decode_chunk, encode_chunk};
 use pmc_geometry::glam::DVec3;

@@ -1,8 +1,6 @@
 //! The server on a real socket (127.0.0.1 only): serving, shutdown, and a taken port.
 
-use crate::common;
-
-use common::small_config;
+use crate::common::small_config;
 use pmc_server::{Server, ServerConfig, ServerError};
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};

@@ -1,11 +1,9 @@
 //! The navigation endpoints: `/api/v1/path` and `/api/v1/navgrid`, on plain planets and on a
 //! world whose grid follows its edits.
 
-use crate::common;
-
+use crate::common::{get, send, small_config, small_layout};
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
-use common::{get, send, small_config, small_layout};
 use pmc_edit::{BrushKind, BrushOp};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::LatLon;
