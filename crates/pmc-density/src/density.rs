@@ -53,6 +53,19 @@ pub trait Density: Send + Sync {
         self.sample_shell(dirs, radii, out);
     }
 
+    /// Whether every sample of the batch `dirs` × `radii` has one sign, told without computing
+    /// them all where the source can: `Some(true)` when [`Density::sample_shell`] gives every
+    /// sample a value above zero (solid), `Some(false)` when it gives every one zero or below
+    /// (air), `None` when they may differ or the source cannot tell (the default). Never `Some`
+    /// for a batch whose samples differ in sign. A chunk whose batch has one sign holds no
+    /// surface, so it need not be sampled and meshed: a column model decides each column from
+    /// its lowest and highest sample, refining its height only as far as these two need, and
+    /// stops at the first column that does not settle it.
+    fn uniform_sign(&self, dirs: &[DVec3], radii: &[f64]) -> Option<bool> {
+        let _ = (dirs, radii);
+        None
+    }
+
     /// Radii between which the surface can lie: below the first everything is solid, above the
     /// second everything is air. `None` when the source cannot tell. Used to skip chunks that
     /// hold no surface without sampling them.
@@ -163,6 +176,9 @@ impl<T: Density + ?Sized> Density for Box<T> {
     fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
         (**self).sample_shell_keeping(dirs, radii, out, columns)
     }
+    fn uniform_sign(&self, dirs: &[DVec3], radii: &[f64]) -> Option<bool> {
+        (**self).uniform_sign(dirs, radii)
+    }
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         (**self).radial_bounds()
     }
@@ -180,6 +196,9 @@ impl<T: Density + ?Sized> Density for std::sync::Arc<T> {
     }
     fn sample_shell_keeping(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], columns: &mut ShellColumns) {
         (**self).sample_shell_keeping(dirs, radii, out, columns)
+    }
+    fn uniform_sign(&self, dirs: &[DVec3], radii: &[f64]) -> Option<bool> {
+        (**self).uniform_sign(dirs, radii)
     }
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         (**self).radial_bounds()

@@ -162,6 +162,22 @@ impl<D: Density> Density for EditedDensity<D> {
         self.apply_edits(dirs, radii, out);
     }
 
+    /// The base's answer when no shaping operation's reach meets the batch's bounding cone
+    /// shell (then every sample keeps the base's bits), else `None`.
+    fn uniform_sign(&self, dirs: &[DVec3], radii: &[f64]) -> Option<bool> {
+        if !self.shaping.is_empty() && !dirs.is_empty() {
+            let bound = ConeShell::of_batch(dirs, radii);
+            if self
+                .shaping
+                .iter()
+                .any(|&i| bound.may_meet_ball(self.edits[i].center, self.edits[i].reach()))
+            {
+                return None;
+            }
+        }
+        self.base.uniform_sign(dirs, radii)
+    }
+
     fn radial_bounds(&self) -> Option<(f64, f64)> {
         self.bounds
     }

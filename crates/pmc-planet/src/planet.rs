@@ -375,6 +375,32 @@ impl Planet {
         !(a == b && a != Known::Unknown)
     }
 
+    /// Whether the chunk of `grid` holds no surface by the density's own bound: every sample of
+    /// its batch has one sign ([`Density::uniform_sign`]), and the shell's closure forces none of
+    /// its layers to the other (layers at depth index `<= 0` are made solid, `>= depth` air).
+    /// Such a chunk's mesh is empty, and it is neither sampled nor meshed.
+    fn uniform_by_bound(&self, grid: &ChunkGrid) -> bool {
+        let Some(solid) = self.density.uniform_sign(&grid.dirs, &grid.radii) else {
+            return false;
+        };
+        // layer c of the padded grid lies at depth index k0 + (c - 1) stride
+        let layers = grid.radii.len() as i64;
+        let (bottom, top) = (grid.k0 - grid.stride, grid.k0 + (layers - 2) * grid.stride);
+        if solid {
+            top < self.layout.depth_tiles()
+        } else {
+            bottom > 0
+        }
+    }
+
+    /// An empty mesh of the chunk of `grid` (key and origin set): what the mesher gives a chunk
+    /// that holds no surface.
+    fn empty_mesh(grid: &ChunkGrid, out: &mut ChunkMesh) {
+        out.clear();
+        out.key = Some(grid.key);
+        out.origin = grid.origin;
+    }
+
     /// Meshes one chunk into `out`, reusing `scratch`. Chunks that hold no surface give an empty
     /// mesh (with key and origin set).
     ///
@@ -414,10 +440,8 @@ impl Planet {
     /// [`Planet::mesh_chunk`] on the chunk's grid.
     fn mesh_chunk_in(&self, grid: &ChunkGrid, scratch: &mut ChunkScratch, out: &mut ChunkMesh, reuse: Option<Reuse>) {
         let key = grid.key;
-        if !self.may_hold_surface(&key) {
-            out.clear();
-            out.key = Some(key);
-            out.origin = grid.origin;
+        if !self.may_hold_surface(&key) || self.uniform_by_bound(grid) {
+            Self::empty_mesh(grid, out);
             return;
         }
         if let Some(r) = &reuse {
@@ -624,10 +648,8 @@ impl Planet {
             return self.mesh_chunk(key, scratch, out, reuse);
         }
         let grid = ChunkGrid::new(&self.layout, key);
-        if !self.may_hold_surface(&key) {
-            out.clear();
-            out.key = Some(key);
-            out.origin = grid.origin;
+        if !self.may_hold_surface(&key) || self.uniform_by_bound(&grid) {
+            Self::empty_mesh(&grid, out);
             return;
         }
         scratch.densities.resize(grid.sample_count(), 0.0);

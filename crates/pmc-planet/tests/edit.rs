@@ -757,3 +757,84 @@ proptest! {
         }
     }
 }
+
+/// The earth preset on a small layout: a 128 m shell, eight chunks of 16 m deep, the surface
+/// within 40 m of its middle.
+fn small_earth() -> Planet {
+    Planet::new(PresetKind::Earth, 7, Layout::new(4, 8, 500.0, 2.0, 8).unwrap())
+}
+
+/// The marching-cubes mesh of `key` by hand: the density's batch, the shell's closure, the
+/// mesher (no shading: only whether it holds a triangle is compared).
+fn triangles_by_hand(planet: &Planet, key: ChunkKey) -> usize {
+    let grid = ChunkGrid::new(planet.layout(), key);
+    let mut d = vec![0.0f32; grid.sample_count()];
+    planet.density().sample_shell(&grid.dirs, &grid.radii, &mut d);
+    pmc_mesh::close_shell(&grid, planet.layout().depth_tiles(), &mut d);
+    let mut out = ChunkMesh::default();
+    pmc_mesh::Mesher::default().mesh(&grid, &d, &mut out);
+    out.triangle_count()
+}
+
+#[test]
+fn chunks_of_one_sign_are_empty_without_meshing_and_the_planet_stays_closed() {
+    // The earth density tells chunks whose samples all have one sign from the ends of their
+    // columns, and the planet gives them an empty mesh without sampling them: every such chunk
+    // would have meshed to nothing, every other chunk meshes as by hand, and the planet is closed.
+    let planet = small_earth();
+    let meshes = all_meshes(&planet);
+    assert_closed(&meshes);
+    let mut told = 0;
+    for (key, mesh) in &meshes {
+        let grid = ChunkGrid::new(planet.layout(), *key);
+        if planet.density().uniform_sign(&grid.dirs, &grid.radii).is_some() {
+            told += 1;
+            assert!(mesh.is_empty(), "{key:?} told of one sign");
+        }
+        assert_eq!(mesh.triangle_count(), triangles_by_hand(&planet, *key), "{key:?}");
+    }
+    assert!(
+        told >= meshes.len() / 4,
+        "{told} of {} chunks told of one sign",
+        meshes.len()
+    );
+    // and the chunks of level 1, closing every side against a coarser neighbour
+    let mut scratch = ChunkScratch::default();
+    let mut out = ChunkMesh::default();
+    let mut coarse = 0;
+    for key in planet.layout().chunks(1) {
+        let grid = ChunkGrid::new(planet.layout(), key);
+        if planet.density().uniform_sign(&grid.dirs, &grid.radii).is_some() {
+            coarse += 1;
+            planet.chunk_mesh_lod_into(key, SideMask::ALL, &mut scratch, &mut out);
+            assert!(out.is_empty() && out.key == Some(key), "{key:?} at level 1");
+        }
+    }
+    assert!(coarse > 0, "chunks of level 1 told of one sign");
+}
+
+#[test]
+fn a_bubble_carved_in_a_chunk_of_solid_rock_is_meshed() {
+    // A chunk of one sign stops being one once an edit reaches it: the edited density declines
+    // to tell (regression guard for the shortcut that skips chunks of one sign), the bubble is
+    // meshed, and the planet stays closed.
+    let mut planet = small_earth();
+    let key = planet
+        .layout()
+        .chunks(0)
+        .into_iter()
+        .find(|k| {
+            let grid = ChunkGrid::new(planet.layout(), *k);
+            k.k == 0 && planet.density().uniform_sign(&grid.dirs, &grid.radii) == Some(true)
+        })
+        .expect("a chunk of solid rock at the bottom of the shell");
+    let grid = ChunkGrid::new(planet.layout(), key);
+    let middle = grid.dirs[grid.dirs.len() / 2] * grid.radii[grid.radii.len() / 2];
+    let op = BrushOp::new(BrushKind::Remove, middle, 5.0, 1.0).unwrap();
+    planet.set_edits(vec![op].into());
+    assert_eq!(planet.density().uniform_sign(&grid.dirs, &grid.radii), None);
+    let meshes = all_meshes(&planet);
+    assert!(!meshes[&key].is_empty(), "the bubble is meshed");
+    assert_eq!(meshes[&key].triangle_count(), triangles_by_hand(&planet, key));
+    assert_closed(&meshes);
+}

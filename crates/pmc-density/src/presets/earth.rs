@@ -719,6 +719,32 @@ impl EarthModel {
         }
     }
 
+    /// The sign every sample of `col` from radius `lo` up to radius `hi` takes, when the samples
+    /// at the two ends settle it (`col` refined as far as both need): `Some(false)` (air) when
+    /// the sample at `lo` stops above the surface, `Some(true)` (solid) when the one at `hi`
+    /// stops below it, else `None`.
+    ///
+    /// Why the ends settle the samples between them: a sample at `r` stops at the first entry
+    /// `k` whose interval `(keep_lo[k], keep_hi[k])` does not hold it, and there `r` lies beyond
+    /// the entry's own bound, `r >= h_k + max(8 B_k, B_k + W_up)` above the surface (value
+    /// `h_k - r < 0`) or `r <= h_k - max(8 B_k, B_k + W_down)` below it (value `> 0`): the first
+    /// entry whose interval drops `r` is one whose own bound does, as the interval before held
+    /// it. The intervals are nested, so a sample above one that stopped above the surface at
+    /// `k` lies outside interval `k` on the same side and stops there or earlier, above the
+    /// surface again (its value below zero); below the surface alike.
+    fn column_sign(&self, col: &EarthColumn, lo: f64, hi: f64) -> Option<bool> {
+        let stop = |r: f64| (0..=col.done).find(|&k| !col.keeps(k, r));
+        if let Some(k) = stop(lo) {
+            if col.h[k] - lo < 0.0 {
+                return Some(false);
+            }
+        }
+        match stop(hi) {
+            Some(k) if col.h[k] - hi > 0.0 => Some(true),
+            _ => None,
+        }
+    }
+
     /// The full formula near the surface: the height field displaced by rocks and cliffs, carved
     /// by caves.
     #[inline]
@@ -877,6 +903,73 @@ impl EarthDensity {
     }
 }
 
+impl EarthDensity {
+    /// [`Density::uniform_sign`]: each column (from the cache, as the batch takes it, and kept
+    /// there) refined only as far as its lowest and highest sample need, and asked for the sign
+    /// of its samples ([`EarthModel::column_sign`]); the first column that does not settle it,
+    /// or settles the other sign, ends the call. A surface chunk is told apart after a column or
+    /// a few; a chunk with no surface costs its columns (which the chunks above and below it
+    /// share through the cache) and not its samples. Radii out of order or negative give
+    /// `None`, as the batch's sorted walk needs them in order.
+    fn one_sign(&self, dirs: &[DVec3], radii: &[f64]) -> Option<bool> {
+        let (first, last) = (*radii.first()?, *radii.last()?);
+        if !(first >= 0.0 && radii.windows(2).all(|w| w[0] <= w[1])) {
+            return None;
+        }
+        let m = &*self.0;
+        let mut sign = None;
+        let mut scratch: Option<EarthColumn> = None;
+        for dir in dirs {
+            // the radii the batch's samples take (`|dir * r|`, in the same order)
+            let (lo, hi) = ((*dir * first).length(), (*dir * last).length());
+            // A kept column refined as far as both ends need is read where it is: most columns
+            // of a chunk with no surface were refined by a chunk above or below it.
+            let kept = self.1.read(*dir, |c| {
+                let refined = c.done == m.entries.len() || !(c.keeps(c.done, lo) || c.keeps(c.done, hi));
+                refined.then(|| m.column_sign(c, lo, hi))
+            });
+            let s = match kept.flatten() {
+                Some(s) => s?,
+                None => self.refined_sign(m, &mut scratch, *dir, lo, hi)?,
+            };
+            if *sign.get_or_insert(s) != s {
+                return None;
+            }
+        }
+        sign
+    }
+
+    /// The sign of the samples of the column of `dir` from `lo` up to `hi`
+    /// ([`EarthModel::column_sign`]), the column taken from the cache as far as it is kept (or
+    /// made in `scratch`), refined as far as both ends need, and kept again.
+    fn refined_sign(
+        &self,
+        m: &EarthModel,
+        scratch: &mut Option<EarthColumn>,
+        dir: DVec3,
+        lo: f64,
+        hi: f64,
+    ) -> Option<bool> {
+        let (col, fresh) = match scratch {
+            Some(c) => (c, false),
+            None => (scratch.insert(m.column(dir)), true),
+        };
+        let done = if self.1.get_into(dir, col) {
+            Some(col.done)
+        } else {
+            if !fresh {
+                m.column_into(dir, col);
+            }
+            None
+        };
+        m.refine_batch(col, dir, &[lo, hi], true);
+        if done.is_none_or(|d| d < col.done) {
+            self.1.put(dir, col);
+        }
+        m.column_sign(col, lo, hi)
+    }
+}
+
 /// Columns kept for the next batches that sample the same directions, by the bits of the
 /// direction: the chunks stacked in one column of the shell (3.3 on average in a view near the
 /// ground in the mountains) and the borders that neighbouring chunks share sample the same
@@ -987,6 +1080,17 @@ impl ColumnCache {
         false
     }
 
+    /// `f` of the column kept for `dir`, read in place under its shard's lock (no copy), if one
+    /// is kept.
+    fn read<R>(&self, dir: DVec3, f: impl FnOnce(&EarthColumn) -> R) -> Option<R> {
+        let (k, i) = Self::key(dir);
+        let shard = self.shard(i);
+        let slot = shard
+            .iter()
+            .find_map(|g| g.slots.get(&k).map(|&s| &g.columns[s as usize]))?;
+        Some(f(slot))
+    }
+
     /// Keeps a copy of `col`, the column of `dir`, unless one refined as far is kept already.
     fn put(&self, dir: DVec3, col: &EarthColumn) {
         let (k, i) = Self::key(dir);
@@ -1053,6 +1157,10 @@ impl Density for EarthDensity {
         columns.keep_reusing(owner, dirs, |kept: &mut Vec<EarthColumn>| {
             self.batch(dirs, radii, out, Some(kept))
         });
+    }
+
+    fn uniform_sign(&self, dirs: &[DVec3], radii: &[f64]) -> Option<bool> {
+        self.one_sign(dirs, radii)
     }
 
     fn radial_bounds(&self) -> Option<(f64, f64)> {
@@ -1733,6 +1841,82 @@ mod tests {
             }
         }
         assert_eq!(checked, 300 * 40);
+    }
+
+    #[test]
+    fn a_batch_of_one_sign_is_told_by_the_ends_of_its_columns() {
+        // Patches of land (hills, mountains with cliffs, cave regions) and sea, with layers from
+        // far below the surface to far above it, at spacings of one voxel to a coarse level's:
+        // wherever `uniform_sign` says a sign, the batch gives every sample that sign, cold or
+        // warm; batches across the surface are never told one sign; and most batches of one
+        // sign outside the 3D terms' reach are told.
+        let (layout, m, warm) = earth(7);
+        let dirs_all = sphere_dirs(400);
+        let mut picks: Vec<DVec3> = Vec::new();
+        let mut want = |pred: &dyn Fn(&EarthColumn, f64) -> bool, n: usize| {
+            picks.extend(
+                dirs_all
+                    .iter()
+                    .copied()
+                    .filter(|d| {
+                        let (c, h) = full(&m, *d);
+                        pred(&c, h)
+                    })
+                    .take(n),
+            )
+        };
+        want(&|c, _| c.mountains > 0.3 && c.a_cliff > 0.0, 2);
+        want(&|c, _| c.cave_gate > 0.5, 2);
+        want(&|_, h| h < m.sea - 2000.0, 1);
+        want(&|c, h| h > m.sea && c.mountains == 0.0, 1);
+        assert_eq!(picks.len(), 6, "patches of every kind");
+        let l_d = layout.l_d();
+        let (mut told, mut one_sign, mut far) = (0, 0, 0);
+        for base in picks {
+            let h = full(&m, base).1;
+            let step = 3.0 * l_d / m.sea;
+            let (u, w) = base.any_orthonormal_pair();
+            let dirs: Vec<DVec3> = (0..64)
+                .map(|i| (base + u * (step * f64::from(i % 8)) + w * (step * f64::from(i / 8))).normalize())
+                .collect();
+            for spacing in [1.0f64, 2.0, 16.0] {
+                for from in (-160..=60).step_by(4) {
+                    let radii: Vec<f64> = (0..35)
+                        .map(|k| h + f64::from(from) * l_d * spacing.min(4.0) + f64::from(k) * spacing * l_d)
+                        .collect();
+                    let mut out = vec![0.0f32; dirs.len() * radii.len()];
+                    EarthDensity::new(m.clone()).sample_shell(&dirs, &radii, &mut out);
+                    let solid = out.iter().filter(|v| **v > 0.0).count();
+                    let sign = (solid == 0 || solid == out.len()).then_some(solid > 0);
+                    let cold = EarthDensity::new(m.clone()).uniform_sign(&dirs, &radii);
+                    let hot = warm.uniform_sign(&dirs, &radii);
+                    assert_eq!(cold, hot, "a warm cache tells what a cold one does");
+                    if let Some(s) = cold {
+                        assert_eq!(
+                            sign,
+                            Some(s),
+                            "told {s} for a batch of {solid} solid samples of {}",
+                            out.len()
+                        );
+                        told += 1;
+                    }
+                    if sign.is_some() {
+                        one_sign += 1;
+                        // clear of the 3D terms (caves reach under 70 voxels down, the rest
+                        // 18 up) by a margin for the other columns' heights
+                        if radii[0] > h + 40.0 * l_d || radii[34] < h - 120.0 * l_d {
+                            far += 1;
+                            assert!(cold.is_some(), "a batch clear of the surface is told its sign");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            far > 100 && told >= far,
+            "{told} told of {one_sign} of one sign ({far} clear of the surface)"
+        );
+        assert!(told < one_sign, "some batches near the surface cannot be told");
     }
 
     #[test]
