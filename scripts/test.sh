@@ -33,11 +33,14 @@ step "install the viewer's packages, Chromium for its end-to-end tests, and the 
 if [ ! -d viewer/node_modules ]; then
   (cd viewer && npm ci --no-audit --no-fund --loglevel=error)
 fi
-# Debian packages: chromium (the end-to-end tests), ferret-datasets (NOAA's ETOPO5 and ETOPO20
-# relief, read by the data-kept tests) and xplanet-images (NASA's Visible Earth, the imagery
-# tests and pictures).
+# Debian packages: chromium (the end-to-end tests), Mesa's EGL and software driver (llvmpipe, the
+# WebGL of most steps: viewer/e2e/harness.mjs), ferret-datasets (NOAA's ETOPO5 and ETOPO20 relief,
+# read by the data-kept tests) and xplanet-images (NASA's Visible Earth, the imagery tests and
+# pictures).
 missing=()
 command -v chromium >/dev/null 2>&1 || missing+=(chromium)
+ls /usr/lib/*/libEGL_mesa.so.0 >/dev/null 2>&1 || missing+=(libegl-mesa0)
+ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1 || missing+=(libgl1-mesa-dri)
 [ -f /usr/share/ferret-vis/data/etopo5.cdf ] || missing+=(ferret-datasets)
 [ -f /usr/share/xplanet/images/earth.jpg ] || missing+=(xplanet-images)
 if [ ${#missing[@]} -gt 0 ]; then

@@ -6,11 +6,14 @@ import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
-import { CHROMIUM, CHROMIUM_ARGS, READY_MS, VIEWPORT, artifacts, check, cleanups, log, withTimeout } from './harness.mjs';
+import { CHROMIUM, GL, READY_MS, VIEWPORT, artifacts, check, chromiumArgs, cleanups, log, withTimeout } from './harness.mjs';
 import { decodePng } from './images.mjs';
 
-/** Launches Chromium; returns its first page and the helpers, shared by every step. */
-export async function openBrowser() {
+/**
+ * Launches Chromium with WebGL by `gl` (llvmpipe or swiftshader: see GL in harness.mjs); returns
+ * its first page and the helpers, shared by every step.
+ */
+export async function openBrowser(gl = GL) {
   const profile = mkdtempSync(join(tmpdir(), 'pmc-e2e-chromium-'));
   cleanups.push(() => rmSync(profile, { recursive: true, force: true }));
   log(`launching ${CHROMIUM}`);
@@ -20,7 +23,7 @@ export async function openBrowser() {
       headless: true,
       viewport: VIEWPORT,
       deviceScaleFactor: 1,
-      args: CHROMIUM_ARGS,
+      args: chromiumArgs(gl),
     }),
     60_000,
     'launching Chromium',
@@ -41,6 +44,17 @@ export async function openBrowser() {
   }
   const page = context.pages()[0] ?? (await context.newPage());
   page.setDefaultTimeout(60_000);
+  // the software renderer behind WebGL (GL in harness.mjs), said in the log and checked
+  const renderer = await page.evaluate(() => {
+    const context = document.createElement('canvas').getContext('webgl2');
+    if (!context) return 'no WebGL 2';
+    const info = context.getExtension('WEBGL_debug_renderer_info');
+    return String(context.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : context.RENDERER));
+  });
+  log(`WebGL 2: ${renderer}`);
+  if (!(gl === 'llvmpipe' ? /llvmpipe/ : /SwiftShader/).test(renderer)) {
+    throw new Error(`the browser's WebGL is not ${gl} but ${renderer} (Mesa's llvmpipe needs Debian's libegl-mesa0 and libgl1-mesa-dri; PMC_E2E_GL=swiftshader uses Chromium's own)`);
+  }
 
   const consoleProblems = [];
   /** URLs whose failure a test provokes on purpose. */

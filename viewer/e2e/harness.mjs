@@ -2,7 +2,7 @@
 // run on every exit, timeouts, child processes, and the steps with their results.
 
 import { spawn } from 'node:child_process';
-import { existsSync } from 'node:fs';
+import { existsSync, readdirSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
@@ -28,18 +28,44 @@ export const VIEWPORT = { width: 1024, height: 640 };
 // How long a view may take to settle: a guard against a hang, not a speed test (the slowest view,
 // the Earth descent's 100 m stop, settles in about 15 s on a 2-core machine with software WebGL).
 export const READY_MS = 240_000;
-/** The headless Chromium of every test: software WebGL, nothing from outside. */
-export const CHROMIUM_ARGS = [
-  '--no-sandbox',
-  '--disable-gpu',
-  '--use-angle=swiftshader',
-  '--enable-unsafe-swiftshader',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-  '--no-first-run',
-  '--disable-quic',
-];
+/** Whether Mesa's EGL and its software driver (Debian's libegl-mesa0 and libgl1-mesa-dri) are installed. */
+function mesaInstalled() {
+  const lib = ['/usr/lib', '/usr/lib64'].filter((d) => existsSync(d));
+  const dirs = lib.flatMap((d) => [d, ...readdirSync(d).filter((n) => n.endsWith('-linux-gnu')).map((n) => join(d, n))]);
+  return dirs.some((d) => existsSync(join(d, 'libEGL_mesa.so.0'))) && dirs.some((d) => existsSync(join(d, 'dri', 'swrast_dri.so')));
+}
+/**
+ * The software renderer behind the steps' WebGL: Mesa's llvmpipe (through ANGLE's EGL back end)
+ * where Mesa is installed, as Debian's chromium package brings it, else Chromium's own SwiftShader;
+ * PMC_E2E_GL=llvmpipe or swiftshader picks one. A frame costs about a quarter under llvmpipe on
+ * two cores (docs/BENCHMARKS.md). The flights' pictures with back faces flagged stay on
+ * SwiftShader (`FLIGHTS_GL`); the browser's renderer is logged at launch.
+ */
+export const GL = process.env.PMC_E2E_GL ?? (mesaInstalled() ? 'llvmpipe' : 'swiftshader');
+if (GL !== 'llvmpipe' && GL !== 'swiftshader') throw new Error(`PMC_E2E_GL must be llvmpipe or swiftshader, not ${GL}`);
+/**
+ * The renderer of the flights (steps 9, 10 and 11), whose pictures with back faces flagged count
+ * the pixels where a back face won a single antialiasing sample (a gap narrower than a pixel).
+ * Under llvmpipe's multisampling back faces win samples along the far horizon with no gap there
+ * (43 to 77 pixels in the view 2 m over the ocean floor, where SwiftShader has 0 to 2, and none
+ * under either without multisampling), so the flights keep SwiftShader, whose samples the
+ * threshold was measured on.
+ */
+export const FLIGHTS_GL = 'swiftshader';
+/** The headless Chromium of every test with WebGL by `gl`: software, nothing from outside. */
+export function chromiumArgs(gl = GL) {
+  return [
+    '--no-sandbox',
+    ...(gl === 'llvmpipe'
+      ? ['--use-angle=gl-egl', '--ignore-gpu-blocklist']
+      : ['--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader']),
+    '--disable-background-networking',
+    '--disable-component-update',
+    '--disable-sync',
+    '--no-first-run',
+    '--disable-quic',
+  ];
+}
 // A guard against a hung run, not a speed test: every step takes about 10 minutes on a 2-core
 // machine with software WebGL (the viewer draws only when the picture changes), a loaded machine
 // longer, and the gallery (PMC_E2E_GALLERY=1) adds its descents with the sky on.

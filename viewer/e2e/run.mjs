@@ -20,9 +20,11 @@
 //                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
-//   PMC_E2E_LANES=1 one step after the other (by default steps 10, 11, 14 and 15, over true-scale
-//                   planets, and 9 run in a second browser beside the others; the soak, step 18,
-//                   runs last and alone)
+//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9, and step
+//                   15 run in browsers of their own beside the others; the soak, step 18, runs
+//                   last and alone)
+//   PMC_E2E_GL      llvmpipe or swiftshader: the software renderer of WebGL (by default Mesa's
+//                   llvmpipe where installed; the flights always draw with SwiftShader)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
 //
 // The harness is harness.mjs (settings, log, clean-ups, steps), servers.mjs (pmc serve, the front
@@ -36,7 +38,7 @@
 import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { openBrowser } from './browser.mjs';
-import { CHROMIUM, GALLERY, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, selected, short, started, step } from './harness.mjs';
+import { CHROMIUM, FLIGHTS_GL, GALLERY, GL, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, selected, short, started, step } from './harness.mjs';
 import * as closeup from './scenarios/closeup.mjs';
 import * as editing from './scenarios/editing.mjs';
 import * as elevationModel from './scenarios/elevationModel.mjs';
@@ -65,14 +67,20 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
  * page and its planet, the orbit picture of step 2, the server of step 5).
  */
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
-/** Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API). */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays];
 /**
- * The steps over true-scale planets (the earth preset, an elevation model), and the default
- * planet's levels of detail, each with servers of its own: run in a second browser beside the
- * others (PMC_E2E_LANES, by default 2), the two lanes of about the same length.
+ * Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API), and
+ * the colours by place and the sea over true-scale planets (servers of their own).
  */
-const SECOND_LANE = [lodEarth, elevationModel, levelSwitch, seaByData, lodDefault];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays, levelSwitch];
+/**
+ * The flights over true-scale planets (the earth preset, an elevation model) and the default
+ * planet's levels of detail, then the sea by the data, each with servers of their own: in a
+ * browser of their own beside the others (PMC_E2E_LANES, by default 2), the two lanes of about the
+ * same length.
+ */
+const SECOND_LANE = [lodEarth, elevationModel, lodDefault, seaByData];
+/** The steps whose pictures with back faces flagged are drawn by FLIGHTS_GL (harness.mjs). */
+const FLIGHTS = new Set([lodEarth, elevationModel, lodDefault]);
 /** Then, alone on the machine (it compares the times of its views): the soak. */
 const LAST = [soak];
 const LANES = Number(process.env.PMC_E2E_LANES ?? 2);
@@ -100,17 +108,25 @@ async function main() {
     }
     for (const s of REAL_SERVER_SCENARIOS) await step(s.name, () => s.scenario(t));
   };
-  const secondLane = async (on) => {
+  // The second lane's browsers, one for each renderer its steps draw with, each opened when a step
+  // first needs it: their own pages, consoles and requests.
+  const browsers = new Map();
+  const browserFor = async (gl) => {
+    if (!browsers.has(gl)) browsers.set(gl, LANES < 2 && gl === GL ? t : { ...(await openBrowser(gl)), shared: t.shared });
+    return browsers.get(gl);
+  };
+  const secondLane = async () => {
     if (USE_MOCK) return;
-    for (const s of SECOND_LANE) await step(s.name, () => s.scenario(on));
+    for (const s of SECOND_LANE.filter((s) => selected(s.name))) {
+      const on = await browserFor(FLIGHTS.has(s) ? FLIGHTS_GL : GL);
+      await step(s.name, () => s.scenario(on));
+    }
   };
   if (LANES >= 2 && !USE_MOCK && SECOND_LANE.some((s) => selected(s.name))) {
-    // a browser of its own: its page, console and requests are the second lane's
-    const other = { ...(await openBrowser()), shared: t.shared };
-    await Promise.all([firstLane(), secondLane(other)]);
+    await Promise.all([firstLane(), secondLane()]);
   } else {
     await firstLane();
-    await secondLane(t);
+    await secondLane();
   }
   if (!USE_MOCK) for (const s of LAST) await step(s.name, () => s.scenario(t));
   // the README's pictures: asked for (PMC_E2E_GALLERY=1, or PMC_E2E_ONLY naming step 16)

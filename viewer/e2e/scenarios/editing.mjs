@@ -4,7 +4,7 @@ import { existsSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
-import { CHROMIUM, CHROMIUM_ARGS, VIEWPORT, check, cleanups, fetchText, log, withTimeout } from '../harness.mjs';
+import { CHROMIUM, chromiumArgs, VIEWPORT, check, cleanups, fetchText, log, withTimeout } from '../harness.mjs';
 import { crop, fractionDifferent } from '../images.mjs';
 import { startBackend } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
@@ -34,7 +34,7 @@ export async function scenario(t) {
 
   // two browsers, each with its own context (own cookies, connections, event stream)
   const browser = await withTimeout(
-    chromium.launch({ executablePath: CHROMIUM, headless: true, args: CHROMIUM_ARGS }),
+    chromium.launch({ executablePath: CHROMIUM, headless: true, args: chromiumArgs() }),
     60_000,
     'launching a second Chromium',
   );

@@ -14,7 +14,7 @@ import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
-import { CHROMIUM, CHROMIUM_ARGS, LAYOUT, READY_MS, artifacts, check, cleanups, log, withTimeout } from '../harness.mjs';
+import { CHROMIUM, chromiumArgs, LAYOUT, READY_MS, artifacts, check, cleanups, log, withTimeout } from '../harness.mjs';
 import { startBackend, startPmcServe } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
 
@@ -95,7 +95,7 @@ function checkLayout(m, label) {
 export async function scenario(t) {
   const { pageBase } = t.shared;
   log(`  launching a second ${CHROMIUM} for windows of other sizes and a phone`);
-  const browser = await withTimeout(chromium.launch({ executablePath: CHROMIUM, headless: true, args: CHROMIUM_ARGS }), 60_000, 'launching Chromium');
+  const browser = await withTimeout(chromium.launch({ executablePath: CHROMIUM, headless: true, args: chromiumArgs() }), 60_000, 'launching Chromium');
   cleanups.push(() => browser.close());
   const problems = [];
   /** A first visit (no stored state) at `viewport`; `touch`: a phone. */
