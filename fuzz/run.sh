@@ -47,6 +47,7 @@ printf '\x06' > "$h/undo"
 printf '\x07' > "$h/redo"
 printf '\x08limit=3' > "$h/edits"
 printf '\x09' > "$h/stats"
+printf '\x0a\n{"chunks":[{"key":"top/0/1/1/1","seams":5,"priority":2},{"key":"north/1/0/0/0"}]}' > "$h/chunk-batch"
 
 printf '%-14s %12s %10s %s\n' target executions seconds result
 for t in "${TARGETS[@]}"; do

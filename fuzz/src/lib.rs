@@ -107,7 +107,7 @@ fn server() -> &'static Server {
 /// The endpoints the HTTP target sends to: the first byte of an input picks one; the rest, up to
 /// its first newline, is appended to the path (a query string, or a chunk's path), and what
 /// follows the newline is the body.
-const ENDPOINTS: [(Method, &str); 10] = [
+const ENDPOINTS: [(Method, &str); 11] = [
     (Method::GET, "/api/v1/chunks?"),
     (Method::GET, "/api/v1/chunk/"),
     (Method::GET, "/api/v1/planet?"),
@@ -118,6 +118,7 @@ const ENDPOINTS: [(Method, &str); 10] = [
     (Method::POST, "/api/v1/edits/redo?"),
     (Method::GET, "/api/v1/edits?"),
     (Method::GET, "/api/v1/stats?"),
+    (Method::POST, "/api/v1/chunk-batch?"),
 ];
 
 /// One request to the server's router: any answer but a server error (500) is fine; a 503 is a
@@ -142,16 +143,35 @@ pub fn http_request(data: &[u8]) {
         return;
     };
     let s = server();
-    let status = s.runtime.block_on(async {
+    let (status, body) = s.runtime.block_on(async {
         let response = s.app.clone().oneshot(request).await.expect("the router answers");
         let status = response.status();
-        axum::body::to_bytes(response.into_body(), 1 << 26)
+        let body = axum::body::to_bytes(response.into_body(), 1 << 26)
             .await
             .expect("the body is read");
-        status
+        (status, body)
     });
     assert!(
         status != StatusCode::INTERNAL_SERVER_ERROR,
         "{method} {uri}: 500 for a request from outside"
     );
+    if prefix.starts_with("/api/v1/chunk-batch") && status == StatusCode::OK {
+        batch_records_are_no_server_errors(&body, &uri);
+    }
+}
+
+/// A chunk batch's answer (`docs/specs/http-api-v1.md`) is whole, with one record a chunk and
+/// none of them a server error (500).
+fn batch_records_are_no_server_errors(body: &[u8], uri: &str) {
+    assert!(body.len() >= 10 && &body[..4] == b"PMCB", "{uri}: not a batch answer");
+    let count = u32::from_le_bytes(body[6..10].try_into().expect("four bytes")) as usize;
+    let (mut at, mut records) = (10, 0);
+    while at < body.len() {
+        let len = u32::from_le_bytes(body[at..at + 4].try_into().expect("four bytes")) as usize;
+        let status = u16::from_le_bytes([body[at + 6], body[at + 7]]);
+        assert!(status != 500, "{uri}: a record with status 500: {}", String::from_utf8_lossy(&body[at + 8..at + 4 + len]));
+        at += 4 + len;
+        records += 1;
+    }
+    assert_eq!((at, records), (body.len(), count), "{uri}: records");
 }

@@ -78,9 +78,19 @@ export async function openBrowser(gl = GL) {
     });
   };
   watchPage(page);
+  /** The chunks the page asked for: each of a batch (`POST /api/v1/chunk-batch`), or a request's own. */
   const chunkRequests = [];
   page.on('request', (r) => {
     if (r.url().includes('/api/v1/chunk/')) chunkRequests.push(r.url());
+    if (r.url().includes('/api/v1/chunk-batch')) {
+      let keys = [];
+      try {
+        keys = JSON.parse(r.postData() ?? '{}').chunks.map((c) => c.key);
+      } catch {
+        // not a batch the viewer would send: counted as nothing
+      }
+      chunkRequests.push(...keys);
+    }
   });
 
   const hookOn = (p) => (fn, arg) => withTimeout(p.evaluate(fn, arg), READY_MS + 10_000, 'page.evaluate');

@@ -256,17 +256,145 @@ export interface ReachObserver {
   unreachable(): void;
 }
 
+/** The first bytes of a chunk batch's answer (`POST /chunk-batch`, docs/specs/http-api-v1.md). */
+const BATCH_MAGIC = [0x50, 0x4d, 0x43, 0x42]; // "PMCB"
+/** The layout version of a chunk batch's answer this client reads. */
+const BATCH_VERSION = 1;
+/** Bytes of a batch answer's header: magic, version (u16), records to follow (u32). */
+const BATCH_HEADER = 10;
+/** Most chunks one batch asks for (the server takes up to 256). */
+export const MAX_BATCH_CHUNKS = 64;
+/**
+ * Batch requests open at once. A browser opens six connections to a server; two are left to the
+ * other requests (the planet, the edit events' stream, paths).
+ */
+export const MAX_OPEN_BATCHES = 4;
+
+/** One record of a chunk batch's answer: the chunk's index in the request, a status, the payload. */
+export interface BatchRecord {
+  index: number;
+  /** 200: the payload is the chunk (chunk-mesh-v1); else an HTTP status and the UTF-8 message. */
+  status: number;
+  payload: Uint8Array;
+}
+
+/**
+ * Reads a chunk batch's answer as its bytes arrive, in pieces split anywhere: `push` each piece,
+ * get back the records it completed. Throws on bytes that are not a batch answer (a wrong magic or
+ * version, a record out of range, more records than announced).
+ */
+export class BatchReader {
+  private pieces: Uint8Array[] = [];
+  private buffered = 0;
+  /** Records the header announced (-1 until it is read). */
+  count = -1;
+  /** Records read so far. */
+  received = 0;
+
+  /** Whether every record the header announced has been read. */
+  get complete(): boolean {
+    return this.count >= 0 && this.received === this.count && this.buffered === 0;
+  }
+
+  push(piece: Uint8Array): BatchRecord[] {
+    if (piece.byteLength > 0) {
+      this.pieces.push(piece);
+      this.buffered += piece.byteLength;
+    }
+    const out: BatchRecord[] = [];
+    for (;;) {
+      if (this.count < 0) {
+        if (this.buffered < BATCH_HEADER) return out;
+        const h = this.take(BATCH_HEADER);
+        if (BATCH_MAGIC.some((b, i) => h[i] !== b)) throw new Error('not a chunk batch (wrong magic)');
+        const v = new DataView(h.buffer, h.byteOffset, h.byteLength);
+        const version = v.getUint16(4, true);
+        if (version !== BATCH_VERSION) throw new Error(`chunk batch version ${version}, this viewer reads ${BATCH_VERSION}`);
+        this.count = v.getUint32(6, true);
+        continue;
+      }
+      if (this.buffered < 4) return out;
+      const len = new DataView(this.peek(4).buffer).getUint32(0, true);
+      if (len < 4) throw new Error(`chunk batch record of ${len} bytes (at least 4)`);
+      if (this.buffered < 4 + len) return out;
+      if (this.received >= this.count) throw new Error(`chunk batch: more than the ${this.count} records announced`);
+      const r = this.take(4 + len);
+      const v = new DataView(r.buffer, r.byteOffset, r.byteLength);
+      const index = v.getUint16(4, true);
+      if (index >= this.count) throw new Error(`chunk batch record for chunk ${index} of ${this.count}`);
+      out.push({ index, status: v.getUint16(6, true), payload: r.slice(8) });
+      this.received++;
+    }
+  }
+
+  /** The first `n` buffered bytes, copied. */
+  private peek(n: number): Uint8Array {
+    const out = new Uint8Array(n);
+    let at = 0;
+    for (const p of this.pieces) {
+      const k = Math.min(p.byteLength, n - at);
+      out.set(p.subarray(0, k), at);
+      at += k;
+      if (at === n) break;
+    }
+    return out;
+  }
+
+  /** Removes and returns the first `n` buffered bytes (a fresh buffer). */
+  private take(n: number): Uint8Array {
+    const out = this.peek(n);
+    let left = n;
+    while (left > 0) {
+      const p = this.pieces[0]!;
+      if (p.byteLength <= left) {
+        this.pieces.shift();
+        left -= p.byteLength;
+      } else {
+        this.pieces[0] = p.subarray(left);
+        left = 0;
+      }
+    }
+    this.buffered -= n;
+    return out;
+  }
+}
+
+/** A chunk asked for through `PmcApi.chunk`, waiting for its batch's answer. */
+interface BatchWaiter {
+  key: string;
+  opts: ChunkOptions;
+  signal: AbortSignal | undefined;
+  resolve: (chunk: DecodedChunk) => void;
+  reject: (e: unknown) => void;
+  settled: boolean;
+  /** The batch request it went out in (none while queued). */
+  batch: { waiters: BatchWaiter[]; abort: AbortController } | null;
+}
+
+function abortError(): Error {
+  return new DOMException('the chunk was no longer wanted', 'AbortError');
+}
+
 export class PmcApi {
   private readonly fetchFn: FetchFn;
   /** Told whether requests reach the server (the connection monitor). */
   observer: ReachObserver | null = null;
+  /** Whether the server answers chunk batches (null: not known yet; false: one chunk a request). */
+  private batches: boolean | null = null;
+  /** Chunks waiting for a batch, by the planet's query. */
+  private queued = new Map<string, { planet: PlanetChoice; waiters: BatchWaiter[] }>();
+  private openBatches = 0;
+  private flushScheduled = false;
 
   constructor(
     /** Prefix of the API, e.g. `api/v1` (relative to the page) or `http://host:8080/api/v1`. */
     readonly base = 'api/v1',
     fetchFn?: FetchFn,
+    /** `batches: false` asks for each chunk with a request of its own (`chunkAlone`). */
+    opts: { batches?: boolean } = {},
   ) {
     this.fetchFn = fetchFn ?? ((input, init) => fetch(input, init));
+    if (opts.batches === false) this.batches = false;
   }
 
   /** The URL of `path` with the planet choice and extra parameters as query string. */
@@ -346,7 +474,139 @@ export class PmcApi {
     return this.url(`chunk/${key}`, planet, params);
   }
 
-  async chunk(planet: PlanetChoice, key: string, signal?: AbortSignal, opts: ChunkOptions = {}): Promise<DecodedChunk> {
+  /**
+   * One chunk, decoded. Chunks asked for together (in one task) and while batches are open go
+   * out together in one `POST /chunk-batch` (up to MAX_BATCH_CHUNKS a batch, MAX_OPEN_BATCHES
+   * batches at once), each settled as its record arrives; a server without batches (404 or 405 to
+   * the first) is asked one chunk a request (`chunkAlone`) from then on. Aborting `signal` rejects
+   * the chunk at once; when every chunk of a batch sent is settled, the batch is aborted (the
+   * server drops the jobs nobody waits for).
+   */
+  chunk(planet: PlanetChoice, key: string, signal?: AbortSignal, opts: ChunkOptions = {}): Promise<DecodedChunk> {
+    if (this.batches === false) return this.chunkAlone(planet, key, signal, opts);
+    if (signal?.aborted) return Promise.reject(abortError());
+    return new Promise<DecodedChunk>((resolve, reject) => {
+      const w: BatchWaiter = { key, opts, signal, resolve, reject, settled: false, batch: null };
+      const q = this.url('chunk-batch', planet);
+      const group = this.queued.get(q) ?? { planet, waiters: [] };
+      group.waiters.push(w);
+      this.queued.set(q, group);
+      signal?.addEventListener(
+        'abort',
+        () => {
+          if (w.settled) return;
+          w.settled = true;
+          reject(abortError());
+          if (w.batch && w.batch.waiters.every((x) => x.settled)) w.batch.abort.abort();
+        },
+        { once: true },
+      );
+      this.scheduleFlush();
+    });
+  }
+
+  /** Sends the queued chunks once the current task has asked for all it will. */
+  private scheduleFlush(): void {
+    if (this.flushScheduled || this.openBatches >= MAX_OPEN_BATCHES) return;
+    this.flushScheduled = true;
+    queueMicrotask(() => {
+      this.flushScheduled = false;
+      this.flush();
+    });
+  }
+
+  private flush(): void {
+    for (const [q, group] of this.queued) {
+      group.waiters = group.waiters.filter((w) => !w.settled);
+      while (group.waiters.length > 0 && this.openBatches < MAX_OPEN_BATCHES) {
+        void this.sendBatch(group.planet, group.waiters.splice(0, MAX_BATCH_CHUNKS));
+      }
+      if (group.waiters.length === 0) this.queued.delete(q);
+    }
+  }
+
+  private async sendBatch(planet: PlanetChoice, waiters: BatchWaiter[]): Promise<void> {
+    this.openBatches++;
+    const abort = new AbortController();
+    const batch = { waiters, abort };
+    for (const w of waiters) w.batch = batch;
+    const url = this.url('chunk-batch', planet);
+    try {
+      const body = JSON.stringify({
+        chunks: waiters.map((w) => ({ key: w.key, seams: w.opts.seams ?? 0, priority: w.opts.priority ?? 0 })),
+      });
+      const res = await this.request(url, abort.signal, {
+        method: 'POST',
+        headers: { 'Content-Type': 'application/json' },
+        body,
+      });
+      if (res.body === null) throw new ApiError('the chunk batch came without a body', res.status, url);
+      const reader = res.body.getReader();
+      const records = new BatchReader();
+      try {
+        for (;;) {
+          const { done, value } = await reader.read();
+          if (done) break;
+          let got: BatchRecord[];
+          try {
+            got = records.push(value);
+          } catch (e) {
+            throw new ApiError(`${(e as Error).message} (${url})`, res.status, url);
+          }
+          this.batches = true;
+          for (const r of got) this.settle(waiters[r.index], r, url);
+        }
+      } finally {
+        reader.releaseLock();
+      }
+      if (!records.complete) throw new ApiError(`the chunk batch ended after ${records.received} of ${waiters.length} chunks`, 0, url);
+    } catch (e) {
+      const unsupported = this.batches === null && e instanceof ApiError && (e.status === 404 || e.status === 405);
+      if (unsupported) this.batches = false;
+      for (const w of waiters) {
+        if (w.settled) continue;
+        if (unsupported) {
+          // an older server: each chunk on its own
+          w.batch = null;
+          this.chunkAlone(planet, w.key, w.signal, w.opts).then(
+            (c) => this.settleWith(w, () => w.resolve(c)),
+            (err: unknown) => this.settleWith(w, () => w.reject(err)),
+          );
+        } else {
+          this.settleWith(w, () => w.reject(isAbort(e) ? e : e instanceof ApiError ? e : new ApiError(String(e), 0, url)));
+        }
+      }
+    } finally {
+      this.openBatches--;
+      this.scheduleFlush();
+    }
+  }
+
+  private settleWith(w: BatchWaiter, settle: () => void): void {
+    if (w.settled) return;
+    w.settled = true;
+    settle();
+  }
+
+  /** Settles `w` with its record of the batch answered at `url`. */
+  private settle(w: BatchWaiter | undefined, r: BatchRecord, url: string): void {
+    if (w === undefined) return;
+    this.settleWith(w, () => {
+      if (r.status !== 200) {
+        const message = new TextDecoder().decode(r.payload);
+        w.reject(new ApiError(`chunk ${w.key}: ${r.status}: ${message}`, r.status, url, r.status === 503 ? 1 : null, message));
+        return;
+      }
+      try {
+        w.resolve(decodeChunk(r.payload));
+      } catch (e) {
+        w.reject(new ApiError(`chunk ${w.key}: ${(e as Error).message}`, 200, url));
+      }
+    });
+  }
+
+  /** One chunk in a request of its own (`GET /chunk/...`). */
+  async chunkAlone(planet: PlanetChoice, key: string, signal?: AbortSignal, opts: ChunkOptions = {}): Promise<DecodedChunk> {
     const url = this.chunkUrl(planet, key, opts);
     const res = await this.request(url, signal);
     const bytes = await res.arrayBuffer();

@@ -127,8 +127,14 @@ export class App implements TestHookTarget {
     this.cameras = new CameraController(canvas, () => this.scene.terrainMeshes());
 
     this.streamer = new ChunkStreamer(this.api, {
-      onShow: (name, seams, chunk) => this.scene.addChunk(name, seams, chunk),
-      onHide: (name) => this.scene.removeChunk(name),
+      onShow: (name, seams, chunk) => {
+        this.scene.addChunk(name, seams, chunk);
+        this.cameras.groundChanged();
+      },
+      onHide: (name) => {
+        this.scene.removeChunk(name);
+        this.cameras.groundChanged();
+      },
       onError: (message) => this.showError(message),
       onRecovered: () => this.clearError(),
     });

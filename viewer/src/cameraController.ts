@@ -58,6 +58,8 @@ export class CameraController {
   walk = false;
   /** Metres from the eye down to the loaded terrain (walk and fly), null when not known. */
   aboveGround: number | null = null;
+  /** The chunks shown changed since the ground was last measured (see `groundChanged`). */
+  private groundStale = false;
   /** The load range of the last frame, metres. */
   range = 1;
   /** The camera of the last frame, planet frame (the floating origin). */
@@ -183,7 +185,8 @@ export class CameraController {
         place(pos);
         moved = true;
       }
-    } else if (this.mode === 'fly' && (frame % 6 === 0 || moved)) {
+    } else if (this.mode === 'fly' && (frame % 6 === 0 || moved || this.groundStale)) {
+      this.groundStale = false;
       this.aboveGround = this.groundDistance([0, 0, 0], up, 4 * shape.outer);
     } else if (this.mode === 'orbit') {
       this.aboveGround = null;
@@ -210,6 +213,17 @@ export class CameraController {
     this.camera.updateProjectionMatrix();
     this.position = pos;
     return { pos, basis, moved };
+  }
+
+  /**
+   * The chunks shown changed: flying, the ground is measured again at the next frame, not up to
+   * six frames later. The near plane follows the height above the ground, and the view's
+   * selection its frustum, so a view is settled only once the ground under it was measured on
+   * the chunks it shows (a selection made from the ground of coarser chunks changed after the
+   * view was reported ready).
+   */
+  groundChanged(): void {
+    this.groundStale = true;
   }
 
   /** Orbit: drag and zoom; fly and walk: look, speed on the wheel, move. True when it moved. */

@@ -35,7 +35,7 @@ export interface StreamerCallbacks {
 }
 
 export interface StreamerOptions {
-  /** At most this many chunk requests in flight (default 6). */
+  /** At most this many chunks in flight (default DEFAULT_MAX_CONCURRENT). */
   maxConcurrent?: number;
   /** Loaded chunks kept at most (shown and wanted ones are never dropped; default 6000). */
   maxLoaded?: number;
@@ -123,7 +123,13 @@ export interface StreamerStats {
   bridges: number;
 }
 
-export const DEFAULT_MAX_CONCURRENT = 6;
+/**
+ * Chunks in flight at once by default. The API client sends them in batches (`PmcApi.chunk`), so
+ * this is not the browser's six connections: enough to keep the server's workers busy while each
+ * chunk waits for its round trip (on two cores about 25 ms), few enough that a view that changes
+ * drops little work.
+ */
+export const DEFAULT_MAX_CONCURRENT = 32;
 
 export class ChunkStreamer {
   private planet: PlanetChoice = {};

@@ -182,8 +182,11 @@ export class FrameLoop {
     if (this.redraw.shouldDraw(now, moved || inputActive(input), settled, changed, this.gpu.busy)) this.draw(now);
 
     const st = streamer.stats();
+    const wasReady = readiness.ready;
     readiness.frame(!flying && steps.busy() === null && selection.current() && settled);
-    if (now - this.lastUiUpdate > 200) {
+    // the panels every 200 ms, and in the frame the view becomes ready: what they say then is
+    // what is shown (a waiter of `__pmc.ready()` reads them after this frame)
+    if (now - this.lastUiUpdate > 200 || (readiness.ready && !wasReady)) {
       this.lastUiUpdate = now;
       const s = cameras.state;
       // the scale bar: the ground's scale where the view's axis meets the sphere of the ground

@@ -126,7 +126,8 @@ export function streamerOn(server: ReturnType<typeof chunkServer>, opts: Streame
   const log: string[] = [];
   const errors: string[] = [];
   const s = new ChunkStreamer(
-    new PmcApi('/api/v1', server.fetchFn),
+    // one chunk a request: this server answers `GET /chunk/...` (the batches are tested in api.test.ts)
+    new PmcApi('/api/v1', server.fetchFn, { batches: false }),
     {
       onShow: (name, seams, chunk) => {
         shown.set(name, { seams, triangles: chunk.indexCount / 3 });

@@ -445,7 +445,7 @@ describe('PmcApi', () => {
 
   it('rejects a chunk that does not decode, naming it', async () => {
     const api = new PmcApi('/api/v1', async () => new Response(new Uint8Array([1, 2, 3]), { status: 200 }));
-    await expect(api.chunk({}, 'top/0/1/2/3')).rejects.toThrow(/chunk top\/0\/1\/2\/3: chunk-mesh-v1: buffer of 3 bytes/);
+    await expect(api.chunkAlone({}, 'top/0/1/2/3')).rejects.toThrow(/chunk top\/0\/1\/2\/3: chunk-mesh-v1: buffer of 3 bytes/);
   });
 
   it('rejects an unexpected planet document', async () => {

@@ -172,14 +172,41 @@ pub async fn chunk(
     let params = Params::parse(q);
     let id = params.planet(&state)?;
     let priority = params.priority()?;
+    let layout = state.config().layout;
+    let key = chunk_key(&layout, &face, &level, &i, &j, &k)?;
+    let seams = SideMask(params.seams()? & layout.seam_sides(&key).0);
+    match state.chunk(ChunkId { planet: id, key, seams }, priority).await {
+        Ok(bytes) => {
+            let mut r = bytes.into_response();
+            let h = r.headers_mut();
+            h.insert(
+                header::CONTENT_TYPE,
+                HeaderValue::from_static("application/octet-stream"),
+            );
+            h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+            Ok(r)
+        }
+        Err(e) => Err(chunk_error(e)),
+    }
+}
+
+/// The chunk named by the five parts of a chunk path (`face/level/i/j/k`): 400 when a part is
+/// malformed, 404 when it is not a chunk of `layout`.
+pub(crate) fn chunk_key(
+    layout: &pmc_geometry::Layout,
+    face: &str,
+    level: &str,
+    i: &str,
+    j: &str,
+    k: &str,
+) -> Result<ChunkKey, ApiError> {
     let face: Face = face.parse().map_err(ApiError::bad_request)?;
     let (level, i, j, k) = (
-        index_part("level", &level)?,
-        index_part("i", &i)?,
-        index_part("j", &j)?,
-        index_part("k", &k)?,
+        index_part("level", level)?,
+        index_part("i", i)?,
+        index_part("j", j)?,
+        index_part("k", k)?,
     );
-    let layout = state.config().layout;
     let max_level = layout.max_level();
     let shown = format!("{}/{level}/{i}/{j}/{k}", face.name());
     if level > u64::from(max_level) {
@@ -200,24 +227,18 @@ pub async fn chunk(
     if !layout.contains_chunk(&key) {
         return Err(ApiError::not_found(format!("chunk {shown} is not part of this planet")));
     }
-    let seams = SideMask(params.seams()? & layout.seam_sides(&key).0);
-    match state.chunk(ChunkId { planet: id, key, seams }, priority).await {
-        Ok(bytes) => {
-            let mut r = bytes.into_response();
-            let h = r.headers_mut();
-            h.insert(
-                header::CONTENT_TYPE,
-                HeaderValue::from_static("application/octet-stream"),
-            );
-            h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
-            Ok(r)
-        }
-        Err(ChunkError::Busy) => Err(ApiError {
+    Ok(key)
+}
+
+/// The answer to a chunk the generator could not serve.
+pub(crate) fn chunk_error(e: ChunkError) -> ApiError {
+    match e {
+        ChunkError::Busy => ApiError {
             status: StatusCode::SERVICE_UNAVAILABLE,
             message: "the server is busy generating chunks; retry in a second".into(),
-        }),
-        Err(ChunkError::Failed(e)) => Err(ApiError::internal(e.to_string())),
-        Err(ChunkError::Stale) => Err(ApiError::internal("the chunk's planet changed while it was requested")),
+        },
+        ChunkError::Failed(e) => ApiError::internal(e.to_string()),
+        ChunkError::Stale => ApiError::internal("the chunk's planet changed while it was requested"),
     }
 }
 

@@ -8,6 +8,8 @@
 //!   encoded bytes in a cache bounded by [`ServerConfig::cache_bytes`], and concurrent requests
 //!   for one chunk share one generation. More than [`ServerConfig::queue_limit`] waiting jobs
 //!   make new chunk requests answer 503 with `Retry-After: 1`.
+//! - `POST /chunk-batch` asks for up to 256 chunks at once and streams each as it is ready
+//!   ([`batch_api`]): a browser's six connections no longer cap the chunks in flight.
 //! - Requests may name any preset and seed; up to
 //!   [`ServerConfig::max_planets`] planets are kept (those asked for again before those asked
 //!   for once), each with its cached chunks.
@@ -27,6 +29,7 @@
 
 pub mod api;
 pub mod assets;
+pub mod batch_api;
 mod chunk_cache;
 mod config;
 pub mod edit_api;

@@ -1,6 +1,6 @@
 //! The router, listening, and shutdown.
 
-use crate::{api, assets, edit_api, imagery_api, nav_api, relief_api, AppState, ServerConfig, ServerError};
+use crate::{api, assets, batch_api, edit_api, imagery_api, nav_api, relief_api, AppState, ServerConfig, ServerError};
 use axum::extract::Request;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
@@ -11,6 +11,7 @@ use std::future::Future;
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
 use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::compression::predicate::{DefaultPredicate, NotForContentType, Predicate};
 use tower_http::compression::CompressionLayer;
 
 /// Logs one line per request at debug level.
@@ -48,6 +49,7 @@ pub fn router(state: AppState) -> Router {
         .route("/api/v1/planet", get(api::planet))
         .route("/api/v1/chunks", get(api::chunks))
         .route("/api/v1/chunk/{face}/{level}/{i}/{j}/{k}", get(api::chunk))
+        .route("/api/v1/chunk-batch", post(batch_api::chunk_batch))
         .route("/api/v1/stats", get(api::stats))
         .route(imagery_api::IMAGERY_PATH, get(imagery_api::imagery))
         .route(relief_api::RELIEF_PATH, get(relief_api::relief))
@@ -65,7 +67,13 @@ pub fn router(state: AppState) -> Router {
         .with_state(state)
         .layer(middleware::from_fn(log_request))
         .layer(CatchPanicLayer::custom(panic_response))
-        .layer(CompressionLayer::new())
+        // (not the chunk batches' streams: the encoder holds what it has compressed until its
+        // buffer fills, and a batch's records must leave as each chunk is ready)
+        .layer(
+            CompressionLayer::new().compress_when(
+                DefaultPredicate::new().and(NotForContentType::const_new(batch_api::BATCH_CONTENT_TYPE)),
+            ),
+        )
 }
 
 /// A server bound to its address, not yet answering.

@@ -4,6 +4,7 @@
 //! generic code once per crate, not once per file.
 
 mod api;
+mod batch;
 mod common;
 mod edit;
 mod flight;

@@ -263,7 +263,7 @@ async fn a_planet_too_large_for_a_grid_gets_lazy_paths_and_a_400_for_the_grid() 
 /// clearance of 1.9e16 m) hung the server; now a 400.
 #[tokio::test]
 async fn fuzz_findings_are_answered_quickly() {
-    const ENDPOINTS: [&str; 10] = [
+    const ENDPOINTS: [&str; 11] = [
         "/api/v1/chunks?",
         "/api/v1/chunk/",
         "/api/v1/planet?",
@@ -274,6 +274,7 @@ async fn fuzz_findings_are_answered_quickly() {
         "/api/v1/edits/redo?",
         "/api/v1/edits?",
         "/api/v1/stats?",
+        "/api/v1/chunk-batch?",
     ];
     let a = router(AppState::new(small_config()).unwrap());
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/regressions/http_request");

@@ -281,6 +281,10 @@ export async function scenario(t) {
     page.on('request', (req) => {
       const m = /\/api\/v1\/chunk\/([a-z]+\/\d+\/\d+\/\d+\/\d+)/.exec(req.url());
       if (m) fetchedAfter.add(m[1]);
+      // (a batch names its chunks in its body)
+      if (req.url().includes('/api/v1/chunk-batch')) {
+        for (const c of JSON.parse(req.postData() ?? '{"chunks":[]}').chunks) fetchedAfter.add(c.key);
+      }
     });
     const t0 = Date.now();
     await page.click('#offline-retry', { timeout: 5_000 });

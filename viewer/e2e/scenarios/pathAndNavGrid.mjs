@@ -117,11 +117,20 @@ export async function scenario(t) {
   check(p.smoothed !== null && p.smoothed.legs >= 1 && p.smoothed.length <= p.length * 1.0001,
     `the path found has no smoothed form, or a longer one: ${JSON.stringify(p.smoothed)}, walk ${p.length} m`);
   const legsText = `${p.smoothed.legs} leg${p.smoothed.legs === 1 ? '' : 's'}`;
+  const wantStatus = `path: ${distance(p.smoothed.length)} in ${p.smoothed.legs} straight leg${p.smoothed.legs === 1 ? '' : 's'} (grid walk ${distance(p.length)}, ${stepsText})`;
+  const wantStats = `${distance(p.smoothed.length)} · ${legsText}`;
+  // the panels show the path found from the next frame on (the stats panel within 200 ms)
+  await page
+    .waitForFunction(
+      ([a, b]) => document.querySelector('#path-status')?.textContent?.startsWith(a) && document.querySelector('#s-path')?.textContent === b,
+      [wantStatus, wantStats],
+      { timeout: 5_000 },
+    )
+    .catch(() => undefined);
   const shownText = await page.textContent('#path-status');
-  check(shownText.startsWith(`path: ${distance(p.smoothed.length)} in ${p.smoothed.legs} straight leg${p.smoothed.legs === 1 ? '' : 's'} (grid walk ${distance(p.length)}, ${stepsText})`),
-    `the tools panel shows "${shownText}"`);
+  check(shownText.startsWith(wantStatus), `the tools panel shows "${shownText}"`);
   const statsText = await page.textContent('#s-path');
-  check(statsText === `${distance(p.smoothed.length)} · ${legsText}`, `the stats panel shows "${statsText}" for the path`);
+  check(statsText === wantStats, `the stats panel shows "${statsText}" for the path`);
   // the server, asked the same, walks the same length, and its smoothed line is the one drawn
   const q = `path?preset=earthlike&seed=7&from=${encodeURIComponent(p.from)}&to=${encodeURIComponent(p.to)}`;
   const direct = await apiGet(q);
