@@ -107,6 +107,10 @@ export async function scenario(t) {
   check(p1.phase === 'start' && p1.from !== null, `after the first click: ${p1.phase} (${p1.message})`);
   await page.mouse.click(...B);
   await waitFor(page, 'the path', () => !['empty', 'start', 'loading'].includes(window.__pmc.path().phase), null, pathState);
+  // the path found is drawn, and its points projected, from the next frame on
+  await page
+    .waitForFunction(() => { const x = window.__pmc.path(); return x.phase !== 'found' || (x.line > 0 && x.screen.length === x.line); }, null, { timeout: 5_000 })
+    .catch(() => undefined);
   const p = await hook(() => window.__pmc.path());
   log(`  ${p.from} -> ${p.to}: ${p.message}`);
   check(p.phase === 'found', `no path between two points of the close-up: ${p.phase}: ${p.message}`);
@@ -164,6 +168,10 @@ export async function scenario(t) {
   log(`  grid: ${g.nodes} nodes, ${g.edges} steps, ${g.components.length} components within ${g.shown.range.toFixed(0)} m (planet: ${g.totalNodes} nodes, ${g.totalComponents} components), main ${main ? `${main.label} ${main.hex}` : 'none'}`);
   check(g.error === null, `the grid request failed: ${g.error}`);
   check(g.edges > 0 && main !== undefined && main.size * 2 >= g.totalNodes, `no main grid (with steps) in the overlay: ${JSON.stringify(g.components.slice(0, 3))}`);
+  // (the panel shows the grid drawn from the next frame on)
+  await page
+    .waitForFunction((n) => document.querySelector('#navgrid-status')?.textContent?.includes(`${n.toLocaleString('en-US')} nodes`), g.nodes, { timeout: 5_000 })
+    .catch(() => undefined);
   const gridText = await page.textContent('#navgrid-status');
   check(gridText.includes(`${g.nodes.toLocaleString('en-US')} nodes`), `the panel says "${gridText}"`);
   const gridImg = await shot('navgrid');
