@@ -149,14 +149,22 @@ export class Ui {
       this.togglePanel();
       this.panelToggle.blur();
     });
-    for (const d of this.side.querySelectorAll<HTMLDetailsElement>('details[data-section]')) {
-      d.addEventListener('toggle', () => {
+    const sections = [...this.side.querySelectorAll<HTMLDetailsElement>('details[data-section]')];
+    /** Keeps what the sections show (false when nothing changed). */
+    const keepSections = (): void => {
+      let changed = false;
+      for (const d of sections) {
         const name = d.dataset['section'] as PanelSection;
-        if (!PANEL_SECTIONS.includes(name) || this.panel.sections[name] === d.open) return;
+        if (!PANEL_SECTIONS.includes(name) || this.panel.sections[name] === d.open) continue;
         this.panel.sections[name] = d.open;
-        savePanelState(this.storage, this.panel);
-      });
-    }
+        changed = true;
+      }
+      if (changed) savePanelState(this.storage, this.panel);
+    };
+    for (const d of sections) d.addEventListener('toggle', keepSections);
+    // (`toggle` comes a task after the click: a section folded just before leaving the page is
+    // kept as the page goes)
+    window.addEventListener('pagehide', keepSections);
     byId<HTMLButtonElement>('compass').addEventListener('click', (e) => {
       this.callbacks.onNorth();
       (e.currentTarget as HTMLElement).blur();
