@@ -12,7 +12,7 @@
 
 use crate::api::{chunk_error, chunk_key};
 use crate::generator::ChunkId;
-use crate::request::{ApiError, Params};
+use crate::request::{read_body, require_json, ApiError, Params};
 use crate::AppState;
 use axum::body::{Body, Bytes};
 use axum::extract::{RawQuery, Request, State};
@@ -88,24 +88,8 @@ pub async fn chunk_batch(
 ) -> Result<Response, ApiError> {
     let params = Params::parse(q);
     let planet = params.planet(&state)?;
-    let json = req
-        .headers()
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.split(';').next())
-        .is_some_and(|v| v.trim().eq_ignore_ascii_case("application/json"));
-    if !json {
-        return Err(ApiError {
-            status: StatusCode::UNSUPPORTED_MEDIA_TYPE,
-            message: "a chunk batch must be a JSON body with Content-Type: application/json".into(),
-        });
-    }
-    let body = axum::body::to_bytes(req.into_body(), MAX_BATCH_BODY)
-        .await
-        .map_err(|_| ApiError {
-            status: StatusCode::PAYLOAD_TOO_LARGE,
-            message: format!("the chunk batch's body is over {MAX_BATCH_BODY} bytes (or could not be read)"),
-        })?;
+    require_json(&req, "a chunk batch")?;
+    let body = read_body(req, MAX_BATCH_BODY, "the chunk batch's body").await?;
     let parsed: BatchRequest = serde_json::from_slice(&body).map_err(|e| {
         ApiError::bad_request(format!(
             "malformed chunk batch: {e}; send {{\"chunks\": [{{\"key\": \"top/0/3/4/1\", \"seams\": 0, \"priority\": 0}}, \

@@ -3,7 +3,7 @@
 
 use crate::editing::{Action, EditEvent, Editing};
 use crate::generator::PlanetId;
-use crate::request::{ApiError, Params};
+use crate::request::{read_body, require_json, ApiError, Params};
 use crate::AppState;
 use axum::extract::{ConnectInfo, RawQuery, Request, State};
 use axum::http::{header, HeaderValue, StatusCode};
@@ -228,28 +228,11 @@ pub async fn post_edit(
     req: Request,
 ) -> Result<Response, Response> {
     let editing = editing_for(&state, q)?;
-    let json = req
-        .headers()
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.split(';').next())
-        .is_some_and(|v| v.trim().eq_ignore_ascii_case("application/json"));
-    if !json {
-        return Err(ApiError {
-            status: StatusCode::UNSUPPORTED_MEDIA_TYPE,
-            message: "the edit must be a JSON body with Content-Type: application/json".into(),
-        }
-        .into());
-    }
+    require_json(&req, "the edit")?;
     if let Some(r) = rate_limited(&editing, &req) {
         return Err(r);
     }
-    let body = axum::body::to_bytes(req.into_body(), MAX_EDIT_BODY)
-        .await
-        .map_err(|_| ApiError {
-            status: StatusCode::PAYLOAD_TOO_LARGE,
-            message: format!("the edit body is over {MAX_EDIT_BODY} bytes (or could not be read)"),
-        })?;
+    let body = read_body(req, MAX_EDIT_BODY, "the edit body").await?;
     let parsed: EditRequest = serde_json::from_slice(&body).map_err(|e| {
         ApiError::bad_request(format!(
             "malformed edit: {e}; send {{\"brush\": \"remove\", \"x\": .., \"y\": .., \"z\": .., \"radius\": .., \

@@ -61,6 +61,37 @@ impl From<ApiError> for Response {
     }
 }
 
+/// Refuses (415) a request whose body is not declared JSON; `what` names the body in the message
+/// ("the edit", "a chunk batch").
+pub(crate) fn require_json(req: &axum::extract::Request, what: &str) -> Result<(), ApiError> {
+    let json = req
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.split(';').next())
+        .is_some_and(|v| v.trim().eq_ignore_ascii_case("application/json"));
+    if json {
+        Ok(())
+    } else {
+        Err(ApiError {
+            status: StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            message: format!("{what} must be a JSON body with Content-Type: application/json"),
+        })
+    }
+}
+
+/// The body of `req`, at most `max` bytes (413 past it, naming `what`).
+pub(crate) async fn read_body(
+    req: axum::extract::Request,
+    max: usize,
+    what: &str,
+) -> Result<axum::body::Bytes, ApiError> {
+    axum::body::to_bytes(req.into_body(), max).await.map_err(|_| ApiError {
+        status: StatusCode::PAYLOAD_TOO_LARGE,
+        message: format!("{what} is over {max} bytes (or could not be read)"),
+    })
+}
+
 /// The decoded query parameters (the last of repeated names wins).
 pub(crate) struct Params(Vec<(String, String)>);
 

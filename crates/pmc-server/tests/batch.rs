@@ -2,16 +2,14 @@
 //! gets, errors per chunk, whole-batch errors for a malformed request, and a batch abandoned by
 //! its client drops the jobs nobody else waits for.
 
-use crate::common::{app, get, send, small_config, stats};
+use crate::common::{app, get, jobs, send, small_config, stats, stats_until};
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
-use axum::Router;
 use pmc_geometry::{ChunkKey, Layout};
 use pmc_planet::{Planet, PresetKind};
 use pmc_server::batch_api::{BATCH_CONTENT_TYPE, MAX_BATCH, MAX_BATCH_BODY};
 use pmc_server::ServerConfig;
 use serde_json::{json, Value};
-use std::time::Duration;
 
 /// A batch request with `body` as its JSON (`query` after the path, e.g. `?preset=moon`).
 fn batch_request(query: &str, body: &str) -> Request<Body> {
@@ -191,24 +189,6 @@ fn slow_config() -> ServerConfig {
         threads: 1,
         ..small_config()
     }
-}
-
-fn jobs(s: &Value, field: &str) -> u64 {
-    s["jobs"][field]
-        .as_u64()
-        .unwrap_or_else(|| panic!("no jobs.{field} in {s}"))
-}
-
-async fn stats_until(a: &Router, what: &str, done: impl Fn(&Value) -> bool) -> Value {
-    let mut last = Value::Null;
-    for _ in 0..20_000 {
-        last = stats(a).await;
-        if done(&last) {
-            return last;
-        }
-        tokio::time::sleep(Duration::from_millis(1)).await;
-    }
-    panic!("stats never showed {what}: {last}");
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

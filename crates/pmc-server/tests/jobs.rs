@@ -1,7 +1,7 @@
 //! Chunk jobs: requests that go away drop the jobs nobody waits for any more, priorities order
 //! the queue, and chunks of every level of detail are served and cached apart.
 
-use crate::common::{app, get, small_config, stats, Reply};
+use crate::common::{app, get, jobs, small_config, stats, stats_until, Reply};
 use axum::http::StatusCode;
 use axum::Router;
 use pmc_density::Density;
@@ -56,26 +56,6 @@ fn spawn_get(a: &Router, uri: String) -> JoinHandle<Reply> {
 /// Whether a task ended by being aborted.
 fn cancelled(joined: Result<Reply, tokio::task::JoinError>) -> bool {
     matches!(joined, Err(e) if e.is_cancelled())
-}
-
-/// Polls `/api/v1/stats` until `done` holds (a bounded number of times, yielding between polls);
-/// returns the stats that satisfied it.
-async fn stats_until(a: &Router, what: &str, done: impl Fn(&Value) -> bool) -> Value {
-    let mut last = Value::Null;
-    for _ in 0..20_000 {
-        last = stats(a).await;
-        if done(&last) {
-            return last;
-        }
-        tokio::time::sleep(Duration::from_millis(1)).await;
-    }
-    panic!("stats never showed {what}: {last}");
-}
-
-fn jobs(s: &Value, field: &str) -> u64 {
-    s["jobs"][field]
-        .as_u64()
-        .unwrap_or_else(|| panic!("no jobs.{field} in {s}"))
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

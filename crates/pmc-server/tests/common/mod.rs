@@ -70,3 +70,24 @@ pub async fn stats(app: &Router) -> Value {
     assert_eq!(r.status, StatusCode::OK);
     r.json()
 }
+
+/// Polls `/api/v1/stats` until `done` holds (a bounded number of times, yielding between polls);
+/// returns the stats that satisfied it.
+pub async fn stats_until(a: &Router, what: &str, done: impl Fn(&Value) -> bool) -> Value {
+    let mut last = Value::Null;
+    for _ in 0..20_000 {
+        last = stats(a).await;
+        if done(&last) {
+            return last;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(1)).await;
+    }
+    panic!("stats never showed {what}: {last}");
+}
+
+/// `jobs.FIELD` of a stats answer.
+pub fn jobs(s: &Value, field: &str) -> u64 {
+    s["jobs"][field]
+        .as_u64()
+        .unwrap_or_else(|| panic!("no jobs.{field} in {s}"))
+}
