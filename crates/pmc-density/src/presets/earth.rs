@@ -844,6 +844,25 @@ impl EarthDensity {
         EarthDensity(model, ColumnCache::default())
     }
 
+    /// Makes `col` the column of `dir` as far as the cache has it (else a fresh one; `fresh`:
+    /// `col` already is), refines it as far as samples at `rs` need
+    /// ([`EarthModel::refine_batch`]) and keeps it in the cache when it went further.
+    fn refine_cached(&self, col: &mut EarthColumn, fresh: bool, dir: DVec3, rs: &[f64], sorted: bool) {
+        let m = &*self.0;
+        let done = if self.1.get_into(dir, col) {
+            Some(col.done)
+        } else {
+            if !fresh {
+                m.column_into(dir, col);
+            }
+            None
+        };
+        m.refine_batch(col, dir, rs, sorted);
+        if done.is_none_or(|d| d < col.done) {
+            self.1.put(dir, col);
+        }
+    }
+
     /// The batch of [`Density::sample_shell`], leaving in `kept` (when given; cleared first)
     /// every column it used, refined as far as the layers needed, in the order of `dirs`.
     fn batch(&self, dirs: &[DVec3], radii: &[f64], out: &mut [f32], mut kept: Option<&mut Vec<EarthColumn>>) {
@@ -879,19 +898,7 @@ impl EarthDensity {
                     None => (scratch.insert(m.column(*dir)), true),
                 },
             };
-            // the column as far as the cache has it, else a fresh one
-            let done = if self.1.get_into(*dir, col) {
-                Some(col.done)
-            } else {
-                if !fresh {
-                    m.column_into(*dir, col);
-                }
-                None
-            };
-            m.refine_batch(col, *dir, &rs, sorted);
-            if done.is_none_or(|d| d < col.done) {
-                self.1.put(*dir, col);
-            }
+            self.refine_cached(col, fresh, *dir, &rs, sorted);
             if sorted {
                 m.values_sorted(col, *dir, &rs, |k, v| out[k * n + d] = v as f32);
             } else {
@@ -954,18 +961,7 @@ impl EarthDensity {
             Some(c) => (c, false),
             None => (scratch.insert(m.column(dir)), true),
         };
-        let done = if self.1.get_into(dir, col) {
-            Some(col.done)
-        } else {
-            if !fresh {
-                m.column_into(dir, col);
-            }
-            None
-        };
-        m.refine_batch(col, dir, &[lo, hi], true);
-        if done.is_none_or(|d| d < col.done) {
-            self.1.put(dir, col);
-        }
+        self.refine_cached(col, fresh, dir, &[lo, hi], true);
         m.column_sign(col, lo, hi)
     }
 }
