@@ -131,6 +131,41 @@ impl Mesher {
     }
 }
 
+impl Mesher {
+    /// Meshes one chunk as [`Mesher::mesh`] does and adds its caps: the solid part of each of its
+    /// six sides, so the mesh bounds a closed solid on its own and no neighbour of any level
+    /// beside it can open a crack into it (see [`crate::caps`]). Cap vertices on the chunk's
+    /// edges are voxels (their key is the voxel's key twice); the others are the mesh's own.
+    ///
+    /// # Panics
+    /// If `densities.len() != grid.sample_count()`.
+    pub fn mesh_closed(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
+        assert_eq!(
+            densities.len(),
+            grid.sample_count(),
+            "densities must cover the padded chunk grid"
+        );
+        self.start(grid, out);
+        let tables = &*TABLES;
+        let mut ctx = Ctx {
+            grid,
+            densities,
+            mesher: self,
+            out,
+        };
+        if grid.padded <= 128 {
+            march_bit_rows(&mut ctx, tables);
+        } else {
+            march_plain(&mut ctx, tables);
+        }
+        // A chunk with no surface has no cap either: it is all solid or all air.
+        if !ctx.out.indices.is_empty() {
+            ctx.emit_caps();
+        }
+        finish_normals(out);
+    }
+}
+
 /// Normalises the gradient normals in one tight pass (it vectorises, unlike a square root and a
 /// division per vertex inside the march). A zero or non-finite gradient falls back to the
 /// radial direction.
@@ -413,7 +448,7 @@ impl Ctx<'_> {
     ///
     /// Voxel positions factor as `dir(a, b) * radius(c)`, so the frame's reciprocal basis depends
     /// on the column only and is cached per column.
-    fn gradient(&mut self, v: (usize, usize, usize)) -> DVec3 {
+    pub(crate) fn gradient(&mut self, v: (usize, usize, usize)) -> DVec3 {
         let g = self.grid;
         let vi = g.index(v.0, v.1, v.2);
         let gen = self.mesher.generation;

@@ -353,7 +353,7 @@ impl Ctx<'_> {
 
     /// Whether `v` is the canonical first voxel of the edge `v`-`w` along `axis`, and the
     /// interpolation parameter from the canonical first voxel (as the vertex's position uses).
-    fn edge_parameter(&self, v: Voxel, w: Voxel, axis: usize) -> (bool, f64) {
+    pub(crate) fn edge_parameter(&self, v: Voxel, w: Voxel, axis: usize) -> (bool, f64) {
         let g = self.grid;
         let p = g.padded;
         let first_is_v = axis == 2 || g.lattice[v.1 * p + v.0].to_array() < g.lattice[w.1 * p + w.0].to_array();
@@ -482,7 +482,8 @@ impl Ctx<'_> {
             if poly.len() < 3 {
                 continue;
             }
-            for tri in ear_clip(&poly) {
+            let poly: Vec<(u32, DVec2)> = poly.iter().map(|c| (c.index, c.pos)).collect();
+            for tri in ear_clip_indices(&poly) {
                 let [a, b, c] = tri;
                 let t = if flip { [a, c, b] } else { [a, b, c] };
                 self.out.indices.extend_from_slice(&t);
@@ -493,10 +494,21 @@ impl Ctx<'_> {
 
 /// Triangulates a simple polygon (either orientation) by ear clipping; the triangles keep the
 /// polygon's orientation. Degenerate polygons (no ear found) are fanned.
-fn ear_clip(poly: &[Cut]) -> Vec<[u32; 3]> {
+pub(crate) fn ear_clip_indices(poly: &[(u32, DVec2)]) -> Vec<[u32; 3]> {
+    ear_clip_with(poly, false)
+}
+
+/// [`ear_clip_indices`], refusing also an ear with another vertex on its border (`closed`):
+/// polygons with runs of collinear vertices (a cap's side along a chunk edge) then never leave
+/// a remainder of zero area to fan.
+pub(crate) fn ear_clip_closed(poly: &[(u32, DVec2)]) -> Vec<[u32; 3]> {
+    ear_clip_with(poly, true)
+}
+
+fn ear_clip_with(poly: &[(u32, DVec2)], closed: bool) -> Vec<[u32; 3]> {
     let area: f64 = (0..poly.len())
         .map(|i| {
-            let (p, q) = (poly[i].pos, poly[(i + 1) % poly.len()].pos);
+            let (p, q) = (poly[i].1, poly[(i + 1) % poly.len()].1);
             p.perp_dot(q)
         })
         .sum();
@@ -506,11 +518,7 @@ fn ear_clip(poly: &[Cut]) -> Vec<[u32; 3]> {
     while idx.len() > 3 {
         let n = idx.len();
         let ear = (0..n).find(|&i| {
-            let (a, b, c) = (
-                poly[idx[(i + n - 1) % n]].pos,
-                poly[idx[i]].pos,
-                poly[idx[(i + 1) % n]].pos,
-            );
+            let (a, b, c) = (poly[idx[(i + n - 1) % n]].1, poly[idx[i]].1, poly[idx[(i + 1) % n]].1);
             if (b - a).perp_dot(c - b) * sign <= 0.0 {
                 return false;
             }
@@ -518,7 +526,14 @@ fn ear_clip(poly: &[Cut]) -> Vec<[u32; 3]> {
                 if j == i || j == (i + n - 1) % n || j == (i + 1) % n {
                     return true;
                 }
-                let p = poly[k].pos;
+                let p = poly[k].1;
+                if closed {
+                    if p == a || p == b || p == c {
+                        return true;
+                    }
+                    let inside = |u: DVec2, v: DVec2| (v - u).perp_dot(p - u) * sign >= 0.0;
+                    return !(inside(a, b) && inside(b, c) && inside(c, a));
+                }
                 let inside = |u: DVec2, v: DVec2| (v - u).perp_dot(p - u) * sign > 0.0;
                 !(inside(a, b) && inside(b, c) && inside(c, a))
             })
@@ -526,21 +541,17 @@ fn ear_clip(poly: &[Cut]) -> Vec<[u32; 3]> {
         match ear {
             Some(i) => {
                 let n = idx.len();
-                out.push([
-                    poly[idx[(i + n - 1) % n]].index,
-                    poly[idx[i]].index,
-                    poly[idx[(i + 1) % n]].index,
-                ]);
+                out.push([poly[idx[(i + n - 1) % n]].0, poly[idx[i]].0, poly[idx[(i + 1) % n]].0]);
                 idx.remove(i);
             }
             None => {
                 for i in 1..idx.len() - 1 {
-                    out.push([poly[idx[0]].index, poly[idx[i]].index, poly[idx[i + 1]].index]);
+                    out.push([poly[idx[0]].0, poly[idx[i]].0, poly[idx[i + 1]].0]);
                 }
                 return out;
             }
         }
     }
-    out.push([poly[idx[0]].index, poly[idx[1]].index, poly[idx[2]].index]);
+    out.push([poly[idx[0]].0, poly[idx[1]].0, poly[idx[2]].0]);
     out
 }

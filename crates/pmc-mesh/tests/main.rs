@@ -3,5 +3,6 @@
 //! One binary instead of one per file: the suite compiles and links the dependencies'
 //! generic code once per crate, not once per file.
 
+mod caps;
 mod closed_planet;
 mod region;

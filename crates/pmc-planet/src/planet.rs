@@ -849,6 +849,41 @@ impl Planet {
         out
     }
 
+    /// Meshes one chunk of any level closed on its own: its surface and its caps, the solid part
+    /// of each of its six sides ([`pmc_mesh::caps`]), so that it bounds a solid and no
+    /// neighbour of any level beside it can open a crack into it. For clients that pick each
+    /// chunk's level on their own (3D Tiles). The surface is [`Planet::chunk_mesh_into`]'s, bit
+    /// for bit; the caps' triangles follow it. Chunks with no surface give an empty mesh.
+    /// A height-field planet's patches have no volume to close: they come as
+    /// [`Planet::chunk_mesh_into`] gives them.
+    ///
+    /// # Panics
+    /// If `key` is not a chunk of the layout (check with [`Layout::contains_chunk`]).
+    pub fn chunk_mesh_closed_into(&self, key: ChunkKey, scratch: &mut ChunkScratch, out: &mut ChunkMesh) {
+        if self.heightfield.is_some() {
+            self.mesh_chunk(key, scratch, out, None);
+            return;
+        }
+        let grid = self.grid_after(key, scratch.grid.take());
+        if !self.may_hold_surface(&key) || self.uniform_by_bound(&grid) {
+            Self::empty_mesh(&grid, out);
+        } else {
+            scratch.densities.resize(grid.sample_count(), 0.0);
+            self.sample(key, &grid, &mut scratch.densities, Some(&mut scratch.columns));
+            close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
+            scratch.mesher.mesh_closed(&grid, &scratch.densities, out);
+            self.shade_grid(out, &grid, scratch, None, false);
+        }
+        scratch.grid = Some((self.layout, grid));
+    }
+
+    /// [`Planet::chunk_mesh_closed_into`] with fresh buffers.
+    pub fn chunk_mesh_closed(&self, key: ChunkKey) -> ChunkMesh {
+        let mut out = ChunkMesh::default();
+        self.chunk_mesh_closed_into(key, &mut ChunkScratch::default(), &mut out);
+        out
+    }
+
     /// Meshes the chunks that `op` can change ([`pmc_edit::affected_chunks`]), in key order,
     /// on the calling thread: after pushing or undoing `op` and [`Planet::set_edits`], these are
     /// the meshes to replace (empty ones included, with key and origin set, so a cache can drop

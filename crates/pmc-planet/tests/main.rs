@@ -3,6 +3,7 @@
 //! One binary instead of one per file: the suite compiles and links the dependencies'
 //! generic code once per crate, not once per file.
 
+mod closed_chunks;
 mod edit;
 mod lod_seams;
 mod planet;
