@@ -50,6 +50,47 @@ pub fn write_glb<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -> R
     write(meshes, meta, out).map(|_| ())
 }
 
+/// Writes one mesh as a binary glTF 2.0 file of its own, as a 3D Tiles tile's content
+/// (`docs/specs/tiles-v1.md`): the scene `tile` holds one node named `name`, translated by the
+/// mesh's origin (written as an `f64` JSON number) and holding the mesh, with the attributes
+/// laid out as in version 1 of the GLB layout (`docs/specs/glb-v1.md`); `extras` becomes the
+/// asset's extras. Returns the bytes written.
+///
+/// # Errors
+/// [`ExportError::InvalidMesh`] for an inconsistent mesh or one with no triangle, and the
+/// writer's I/O errors.
+pub fn write_tile_glb<W: Write>(
+    mesh: &ChunkMesh,
+    name: &str,
+    generator: &str,
+    extras: Value,
+    out: W,
+) -> Result<u64, ExportError> {
+    let meshes = std::slice::from_ref(mesh);
+    let checked = check_meshes(meshes)?;
+    let Some(c) = checked.first() else {
+        return Err(ExportError::InvalidMesh {
+            index: 0,
+            name: name.to_string(),
+            reason: "a tile needs at least one triangle".to_string(),
+        });
+    };
+    let mut b = Builder {
+        root: gj::Root::default(),
+        blobs: Vec::new(),
+        len: 0,
+        translations: Vec::new(),
+    };
+    b.root.asset = gj::Asset {
+        version: "2.0".to_string(),
+        generator: Some(generator.to_string()),
+        ..Default::default()
+    };
+    let terrain = b.root.push(material("terrain", [1.0; 4], 0.9, false));
+    let node = b.chunk_node(c, name.to_string(), terrain);
+    b.finish("tile", node, extras, out)
+}
+
 /// A slice of vertex or index data, as it goes into the BIN chunk.
 #[derive(Clone, Copy)]
 enum Data<'a> {
@@ -212,6 +253,113 @@ impl<'a> Builder<'a> {
     }
 }
 
+impl<'a> Builder<'a> {
+    /// A chunk's mesh under a node translated to its origin, its attributes as version 1 lays
+    /// them out.
+    fn chunk_node(&mut self, c: &Checked<'a>, name: String, terrain: Index<gj::Material>) -> Index<gj::Node> {
+        let m = c.mesh;
+        let mut attrs = BTreeMap::new();
+        attrs.insert(
+            Valid(Semantic::Positions),
+            self.accessor(
+                Data::Vec3(&m.positions),
+                Target::ArrayBuffer,
+                Some(bounds(&m.positions)),
+            ),
+        );
+        attrs.insert(
+            Valid(Semantic::Normals),
+            self.accessor(Data::Vec3(&m.normals), Target::ArrayBuffer, None),
+        );
+        if c.attributes {
+            attrs.insert(
+                Valid(Semantic::Colors(0)),
+                self.accessor(Data::Rgba(&m.colors), Target::ArrayBuffer, None),
+            );
+            let extra = [
+                ("HEIGHT", Data::Float(&m.heights)),
+                ("WATER_DEPTH", Data::Float(&m.water_depths)),
+                ("MATERIAL", Data::ByteAsFloat(&m.materials)),
+            ];
+            for (sem, data) in extra {
+                attrs.insert(
+                    Valid(Semantic::Extras(sem.to_string())),
+                    self.accessor(data, Target::ArrayBuffer, None),
+                );
+            }
+        }
+        let indices = self.accessor(Data::Index(&m.indices), Target::ElementArrayBuffer, None);
+        let mesh = self.mesh(&name, attrs, indices, terrain);
+        self.node(name, mesh, m.origin)
+    }
+}
+
+impl Builder<'_> {
+    /// Adds the scene over `root`, the buffer, and writes the GLB container: header, JSON chunk
+    /// (with `extras` as the asset's extras and the nodes' translations as `f64`), BIN chunk.
+    /// Returns the bytes written.
+    fn finish<W: Write>(
+        mut self,
+        scene: &str,
+        root: Index<gj::Node>,
+        extras: Value,
+        out: W,
+    ) -> Result<u64, ExportError> {
+        let scene = self.root.push(gj::Scene {
+            extensions: None,
+            extras: Default::default(),
+            name: Some(scene.to_string()),
+            nodes: vec![root],
+        });
+        self.root.scene = Some(scene);
+        if self.len > 0 {
+            self.root.push(gj::Buffer {
+                byte_length: USize64(self.len),
+                name: None,
+                uri: None,
+                extensions: None,
+                extras: Default::default(),
+            });
+        }
+
+        // gltf-json stores translations as f32; write the f64 values into the JSON directly.
+        let mut value = self.root.to_value()?;
+        for &(node, t) in &self.translations {
+            value["nodes"][node]["translation"] = json!([t.x, t.y, t.z]);
+        }
+        value["asset"]["extras"] = extras;
+        let mut json = serde_json::to_vec(&value)?;
+        json.resize(align4(json.len() as u64) as usize, b' ');
+
+        let bin_len = align4(self.len);
+        let total = 12 + 8 + json.len() as u64 + if bin_len > 0 { 8 + bin_len } else { 0 };
+        let total = u32::try_from(total)
+            .map_err(|_| ExportError::TooLarge(format!("{total} bytes, more than a GLB file can hold (4 GiB)")))?;
+
+        let mut out = Counting::new(out);
+        out.write_all(MAGIC)?;
+        out.write_all(&VERSION.to_le_bytes())?;
+        out.write_all(&total.to_le_bytes())?;
+        out.write_all(&(json.len() as u32).to_le_bytes())?;
+        out.write_all(&CHUNK_JSON.to_le_bytes())?;
+        out.write_all(&json)?;
+        if bin_len > 0 {
+            out.write_all(&(bin_len as u32).to_le_bytes())?;
+            out.write_all(&CHUNK_BIN.to_le_bytes())?;
+            let mut at = 0u64;
+            let mut buf = Vec::with_capacity(4096 * 12);
+            for (offset, data) in &self.blobs {
+                out.write_all(&[0u8; 4][..(offset - at) as usize])?;
+                data.write_to(&mut out, &mut buf)?;
+                at = offset + data.byte_len();
+            }
+            out.write_all(&[0u8; 4][..(bin_len - at) as usize])?;
+        }
+        out.flush()?;
+        Ok(out.bytes())
+    }
+}
+
 /// Per-component min and max of positions, as JSON arrays (exact `f32` values).
 fn bounds(p: &[[f32; 3]]) -> (Value, Value) {
     let mut lo = [f32::INFINITY; 3];
@@ -295,41 +443,8 @@ pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -
     if !checked.is_empty() {
         let terrain = b.root.push(material("terrain", [1.0; 4], 0.9, false));
         for c in &checked {
-            let m = c.mesh;
-            let name = node_name(c.index, m);
-            let mut attrs = BTreeMap::new();
-            attrs.insert(
-                Valid(Semantic::Positions),
-                b.accessor(
-                    Data::Vec3(&m.positions),
-                    Target::ArrayBuffer,
-                    Some(bounds(&m.positions)),
-                ),
-            );
-            attrs.insert(
-                Valid(Semantic::Normals),
-                b.accessor(Data::Vec3(&m.normals), Target::ArrayBuffer, None),
-            );
-            if c.attributes {
-                attrs.insert(
-                    Valid(Semantic::Colors(0)),
-                    b.accessor(Data::Rgba(&m.colors), Target::ArrayBuffer, None),
-                );
-                let extra = [
-                    ("HEIGHT", Data::Float(&m.heights)),
-                    ("WATER_DEPTH", Data::Float(&m.water_depths)),
-                    ("MATERIAL", Data::ByteAsFloat(&m.materials)),
-                ];
-                for (sem, data) in extra {
-                    attrs.insert(
-                        Valid(Semantic::Extras(sem.to_string())),
-                        b.accessor(data, Target::ArrayBuffer, None),
-                    );
-                }
-            }
-            let indices = b.accessor(Data::Index(&m.indices), Target::ElementArrayBuffer, None);
-            let mesh = b.mesh(&name, attrs, indices, terrain);
-            children.push(b.node(name, mesh, m.origin));
+            let name = node_name(c.index, c.mesh);
+            children.push(b.chunk_node(c, name, terrain));
         }
     }
 
@@ -365,59 +480,9 @@ pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -
     if !children.is_empty() {
         b.root.nodes[planet.value()].children = Some(children);
     }
-    let scene = b.root.push(gj::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: Some("planet".to_string()),
-        nodes: vec![planet],
-    });
-    b.root.scene = Some(scene);
-    if b.len > 0 {
-        b.root.push(gj::Buffer {
-            byte_length: USize64(b.len),
-            name: None,
-            uri: None,
-            extensions: None,
-            extras: Default::default(),
-        });
-    }
-
-    // gltf-json stores translations as f32; write the f64 values into the JSON directly.
-    let mut value = b.root.to_value()?;
-    for &(node, t) in &b.translations {
-        value["nodes"][node]["translation"] = json!([t.x, t.y, t.z]);
-    }
-    value["asset"]["extras"] = meta.to_json("pmc-glb");
-    let mut json = serde_json::to_vec(&value)?;
-    json.resize(align4(json.len() as u64) as usize, b' ');
-
-    let bin_len = align4(b.len);
-    let total = 12 + 8 + json.len() as u64 + if bin_len > 0 { 8 + bin_len } else { 0 };
-    let total = u32::try_from(total)
-        .map_err(|_| ExportError::TooLarge(format!("{total} bytes, more than a GLB file can hold (4 GiB)")))?;
-
-    let mut out = Counting::new(out);
-    out.write_all(MAGIC)?;
-    out.write_all(&VERSION.to_le_bytes())?;
-    out.write_all(&total.to_le_bytes())?;
-    out.write_all(&(json.len() as u32).to_le_bytes())?;
-    out.write_all(&CHUNK_JSON.to_le_bytes())?;
-    out.write_all(&json)?;
-    if bin_len > 0 {
-        out.write_all(&(bin_len as u32).to_le_bytes())?;
-        out.write_all(&CHUNK_BIN.to_le_bytes())?;
-        let mut at = 0u64;
-        let mut buf = Vec::with_capacity(4096 * 12);
-        for (offset, data) in &b.blobs {
-            out.write_all(&[0u8; 4][..(offset - at) as usize])?;
-            data.write_to(&mut out, &mut buf)?;
-            at = offset + data.byte_len();
-        }
-        out.write_all(&[0u8; 4][..(bin_len - at) as usize])?;
-    }
-    out.flush()?;
+    let bytes = b.finish("planet", planet, meta.to_json("pmc-glb"), out)?;
     Ok(ExportStats {
-        bytes: out.bytes(),
+        bytes,
         vertices: checked.iter().map(|c| c.mesh.positions.len() as u64).sum(),
         triangles: checked.iter().map(|c| c.mesh.indices.len() as u64 / 3).sum(),
         meshes: checked.len(),

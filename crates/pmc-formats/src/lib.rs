@@ -47,7 +47,7 @@ mod weld;
 pub use error::ExportError;
 pub use export::{export, ExportStats};
 pub use format::Format;
-pub use glb::write_glb;
+pub use glb::{write_glb, write_tile_glb};
 pub use meta::ExportMeta;
 pub use obj::write_obj;
 pub use ply::{write_ply, PLY_FACE_BYTES, PLY_VERTEX_BYTES};

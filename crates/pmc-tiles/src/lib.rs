@@ -1,0 +1,528 @@
+//! OGC 3D Tiles 1.1 for planetary marching cubes (`docs/specs/tiles-v1.md`).
+//!
+//! A planet becomes one tileset: an explicit root over six implicit octrees, one per cube face,
+//! whose tiles are the face's chunks of every level ([`implicit`]). Each tile's content is its
+//! chunk *closed* (`pmc_planet::Planet::chunk_mesh_closed`): the surface plus caps on the
+//! chunk's six sides, so a client may put any level beside any other and still show no inside
+//! of a solid through the crack between them (the argument is in `pmc_mesh::caps`). Tiles are
+//! placed in Earth-centred, Earth-fixed metres on the WGS84 ellipsoid or on the planet's sphere
+//! ([`frame`]). Each subtree file carries, per available tile, its bounding sphere and geometric
+//! error as tile metadata (the `TILE_BOUNDING_SPHERE` and `TILE_GEOMETRIC_ERROR` semantics): a
+//! chunk of the cube sphere is not a box of the face root's implicit subdivision, so a client
+//! must read them (CesiumJS does).
+//!
+//! A [`TileSet`] answers the tileset JSON ([`TileSet::tileset_json`]) and builds one subtree at a
+//! time with its tiles' contents ([`TileSet::build_subtree`]): the unit of work of a bake
+//! ([`bake`]) and of a server.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod bake;
+pub mod frame;
+pub mod implicit;
+pub mod subtree;
+
+pub use frame::TileFrame;
+pub use implicit::{TileCoord, Tiling, SUBTREE_LEVELS};
+
+use implicit::{demorton3, octree_tiles};
+use pmc_geometry::glam::DVec3;
+use pmc_geometry::{ChunkKey, Face, LatLon};
+use pmc_mesh::ChunkMesh;
+use pmc_planet::{ChunkScratch, Planet};
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use std::cell::RefCell;
+use std::sync::Arc;
+use subtree::{Bits, Subtree};
+
+/// What can go wrong building tiles.
+#[derive(Debug, thiserror::Error)]
+pub enum TilesError {
+    /// The planet is a height-field planet: its patches have no volume to close.
+    #[error("3D Tiles are made of marching-cubes chunks; a height-field planet (--mesher heightfield) has none")]
+    Heightfield,
+    /// The level errors do not match the planet's levels.
+    #[error("{got} level errors for a planet of {want} levels of detail")]
+    Errors {
+        /// Errors given.
+        got: usize,
+        /// Levels of detail.
+        want: usize,
+    },
+    /// A parameter is out of range.
+    #[error("{0}")]
+    Invalid(String),
+    /// Writing a tile's content failed.
+    #[error("writing tile {tile}: {source}")]
+    Content {
+        /// The tile.
+        tile: String,
+        /// Why.
+        source: pmc_formats::ExportError,
+    },
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+
+/// A region of the planet to tile: the tiles whose bounding spheres meet the ball of `radius`
+/// metres around the place at `lat`, `lon` (degrees) on the datum sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    /// Latitude, degrees.
+    pub lat: f64,
+    /// Longitude, degrees.
+    pub lon: f64,
+    /// Radius, metres.
+    pub radius: f64,
+}
+
+/// Which tiles a tileset holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TileOptions {
+    /// The deepest implicit level (0 is a face's root); `None` for every level of detail.
+    pub max_level: Option<u8>,
+    /// Tiles above this implicit level have no content (they stay in the tree as its path).
+    pub min_level: u8,
+    /// Only the tiles meeting this region (and the path to them).
+    pub region: Option<Region>,
+}
+
+/// A planet as a 3D Tiles tileset.
+#[derive(Clone, Debug)]
+pub struct TileSet {
+    planet: Arc<Planet>,
+    frame: TileFrame,
+    tiling: Tiling,
+    errors: Vec<f64>,
+    options: TileOptions,
+    region: Option<(DVec3, f64)>,
+    generator: String,
+}
+
+/// A built subtree: its file and the contents of its tiles that have one.
+#[derive(Clone, Debug, Default)]
+pub struct SubtreeBuild {
+    /// The subtree file's bytes.
+    pub subtree: Vec<u8>,
+    /// Each tile with content and its glTF binary, in tile order.
+    pub contents: Vec<(TileCoord, Vec<u8>)>,
+    /// The roots of the available child subtrees.
+    pub children: Vec<TileCoord>,
+    /// Available tiles in the subtree.
+    pub available: usize,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<ChunkScratch> = RefCell::new(ChunkScratch::default());
+}
+
+/// The glTF coordinates of an ECEF vector: 3D Tiles turns glTF's Y-up into Z-up by
+/// `(x, y, z) -> (x, -z, y)`, so glTF holds `(X, Z, -Y)`.
+fn gltf_axes(e: DVec3) -> DVec3 {
+    DVec3::new(e.x, e.z, -e.y)
+}
+
+impl TileSet {
+    /// The tileset of `planet` placed in `frame`, with the planet's measured geometric error of
+    /// each level of detail (`pmc_lod::measure_level_errors`, metres, index = level).
+    pub fn new(
+        planet: Arc<Planet>,
+        errors: Vec<f64>,
+        frame: TileFrame,
+        options: TileOptions,
+        generator: &str,
+    ) -> Result<TileSet, TilesError> {
+        if planet.heightfield_mode().is_some() {
+            return Err(TilesError::Heightfield);
+        }
+        let layout = *planet.layout();
+        let tiling = Tiling::new(layout);
+        let want = usize::from(layout.max_level()) + 1;
+        if errors.len() != want || errors.iter().any(|e| !e.is_finite() || *e < 0.0) {
+            return Err(TilesError::Errors {
+                got: errors.len(),
+                want,
+            });
+        }
+        if let Some(m) = options.max_level {
+            if m >= tiling.levels() {
+                return Err(TilesError::Invalid(format!(
+                    "--max-level {m}: this planet's tiles have implicit levels 0 to {}",
+                    tiling.levels() - 1
+                )));
+            }
+        }
+        if let TileFrame::Wgs84 { datum } = frame {
+            if !(datum.is_finite() && datum > 0.0) {
+                return Err(TilesError::Invalid(format!("datum radius {datum} m")));
+            }
+        }
+        let region = match options.region {
+            None => None,
+            Some(r) => {
+                if !(r.radius.is_finite() && r.radius > 0.0) {
+                    return Err(TilesError::Invalid(format!(
+                        "region radius {} m: it must be a positive number of metres",
+                        r.radius
+                    )));
+                }
+                let dir = LatLon::new(r.lat, r.lon)
+                    .map_err(|e| TilesError::Invalid(format!("region: {e}")))?
+                    .to_unit();
+                Some((dir * planet.datum_radius(), r.radius))
+            }
+        };
+        Ok(TileSet {
+            planet,
+            frame,
+            tiling,
+            errors,
+            options,
+            region,
+            generator: generator.to_string(),
+        })
+    }
+
+    /// The planet.
+    pub fn planet(&self) -> &Arc<Planet> {
+        &self.planet
+    }
+
+    /// The frame.
+    pub fn frame(&self) -> TileFrame {
+        self.frame
+    }
+
+    /// The tiling.
+    pub fn tiling(&self) -> &Tiling {
+        &self.tiling
+    }
+
+    /// Implicit levels in the tileset (`availableLevels`).
+    pub fn available_levels(&self) -> u8 {
+        self.options.max_level.map_or(self.tiling.levels(), |m| m + 1)
+    }
+
+    /// The tile's bounding sphere in the planet's frame: its chunk's provable sphere
+    /// (`pmc_lod::chunk_sphere`), or for a virtual tile the ball of the shell's outer radius.
+    fn planet_sphere(&self, t: &TileCoord) -> (DVec3, f64) {
+        match self.tiling.key(t) {
+            Some(key) => {
+                let s = pmc_lod::bounds::chunk_sphere(self.tiling.layout(), &key);
+                (s.center, s.radius)
+            }
+            None => (DVec3::ZERO, self.tiling.layout().radius() * (1.0 + 1e-9)),
+        }
+    }
+
+    /// The tile's bounding sphere in ECEF metres: it holds every vertex of the tile's content
+    /// and of its descendants' (REPLACE refinement), as stored: grown by a millionth for the
+    /// `f32` rounding of positions relative to its centre (at most `√3 · 2^-24` of the radius).
+    pub fn sphere(&self, t: &TileCoord) -> (DVec3, f64) {
+        let (c, r) = self.planet_sphere(t);
+        let (c, r) = self.frame.ball(c, r);
+        (c, r * (1.0 + 1e-6))
+    }
+
+    /// The tile's geometric error, metres: its level's measured error, stretched by the frame;
+    /// a virtual tile's is twice its children's.
+    pub fn geometric_error(&self, t: &TileCoord) -> f64 {
+        let stretch = self.frame.stretch(self.tiling.layout().d_b());
+        match self.tiling.chunk_level(t.level) {
+            Some(l) => self.errors[usize::from(l)] * stretch,
+            None => {
+                let top = *self.errors.last().expect("one error per level");
+                let up = self.tiling.virtual_levels() - t.level;
+                top * stretch * f64::from(1u32 << up)
+            }
+        }
+    }
+
+    /// Whether the tile is in the tileset, its parent being in it: it exists, is within the
+    /// levels asked for and meets the region, and its chunk may hold surface by the planet's
+    /// radial bounds (a sound test: no descendant of a tile that fails it holds surface).
+    pub fn available(&self, t: &TileCoord) -> bool {
+        if t.level >= self.available_levels() || !self.tiling.exists(t) {
+            return false;
+        }
+        if let Some((c, r)) = self.region {
+            let (tc, tr) = self.planet_sphere(t);
+            if (tc - c).length() > tr + r {
+                return false;
+            }
+        }
+        match self.tiling.key(t) {
+            Some(key) => self.planet.may_hold_surface(&key),
+            None => true,
+        }
+    }
+
+    /// The chunk of a tile closed and shaded, or `None` when it has no surface or no chunk.
+    fn closed_mesh(&self, key: ChunkKey) -> ChunkMesh {
+        SCRATCH.with(|s| {
+            let mut out = ChunkMesh::default();
+            match s.try_borrow_mut() {
+                Ok(mut s) => self.planet.chunk_mesh_closed_into(key, &mut s, &mut out),
+                Err(_) => self
+                    .planet
+                    .chunk_mesh_closed_into(key, &mut ChunkScratch::default(), &mut out),
+            }
+            out
+        })
+    }
+
+    /// The tile's content, a binary glTF (see `docs/specs/tiles-v1.md`), or `None` when its
+    /// chunk has no surface. Positions are `f32` relative to the tile's sphere's centre in glTF
+    /// axes, the centre the node's `f64` translation.
+    pub fn content(&self, t: &TileCoord) -> Result<Option<Vec<u8>>, TilesError> {
+        if t.level < self.options.min_level {
+            return Ok(None);
+        }
+        let Some(key) = self.tiling.key(t) else {
+            return Ok(None);
+        };
+        let mut mesh = self.closed_mesh(key);
+        if mesh.indices.is_empty() {
+            return Ok(None);
+        }
+        let (centre, _) = self.sphere(t);
+        for i in 0..mesh.vertex_count() {
+            let w = mesh.world_position_full(i);
+            let n = DVec3::from(mesh.normals[i].map(f64::from));
+            let e = self.frame.to_ecef(w) - centre;
+            mesh.positions[i] = gltf_axes(e).as_vec3().to_array();
+            mesh.normals[i] = gltf_axes(self.frame.normal_to_ecef(w, n)).as_vec3().to_array();
+        }
+        mesh.origin = gltf_axes(centre);
+        mesh.positions_low.clear();
+        let mut out = Vec::new();
+        let name = key.to_string();
+        pmc_formats::write_tile_glb(&mesh, &name, &self.generator, json!({"pmc": {"chunk": name}}), &mut out).map_err(
+            |source| TilesError::Content {
+                tile: format!("{}/{}", t.face, t.path()),
+                source,
+            },
+        )?;
+        Ok(Some(out))
+    }
+
+    /// Builds the subtree rooted at `root` (a tile at a multiple of [`SUBTREE_LEVELS`]): the
+    /// availability of its tiles, the contents of those that have one (meshed in parallel), and
+    /// the availability of its child subtrees. The same bytes every time, on any thread count.
+    pub fn build_subtree(&self, root: TileCoord) -> Result<SubtreeBuild, TilesError> {
+        if root.level % SUBTREE_LEVELS != 0 {
+            return Err(TilesError::Invalid(format!(
+                "tile {}/{} is not the root of a subtree",
+                root.face,
+                root.path()
+            )));
+        }
+        let count = octree_tiles(SUBTREE_LEVELS) as usize;
+        let (coords, tiles) = self.availability(root);
+        let contents: Vec<Option<Vec<u8>>> = (0..count)
+            .into_par_iter()
+            .map(|n| {
+                if tiles.get(n) {
+                    self.content(&coords[n])
+                } else {
+                    Ok(None)
+                }
+            })
+            .collect::<Result<_, _>>()?;
+        let mut content = Bits::zeros(count);
+        let (mut spheres, mut errors) = (Vec::new(), Vec::new());
+        for (n, t) in coords.iter().enumerate() {
+            if contents[n].is_some() {
+                content.set(n);
+            }
+            if tiles.get(n) {
+                let (c, r) = self.sphere(t);
+                spheres.push([c.x, c.y, c.z, r]);
+                errors.push(self.geometric_error(t));
+            }
+        }
+        let (children, child_roots) = self.children_of(root, &tiles);
+        let available = tiles.count();
+        let subtree = Subtree {
+            tiles,
+            content,
+            children,
+            spheres,
+            errors,
+        }
+        .to_bytes();
+        Ok(SubtreeBuild {
+            subtree,
+            contents: coords
+                .into_iter()
+                .zip(contents)
+                .filter_map(|(t, c)| c.map(|c| (t, c)))
+                .collect(),
+            children: child_roots,
+            available,
+        })
+    }
+
+    /// The tiles of the subtree rooted at `root`, in level order and Morton order within a
+    /// level, and which are available: top-down, a tile only under an available parent.
+    fn availability(&self, root: TileCoord) -> (Vec<TileCoord>, Bits) {
+        let count = octree_tiles(SUBTREE_LEVELS) as usize;
+        let mut coords = Vec::with_capacity(count);
+        for d in 0..SUBTREE_LEVELS {
+            for m in 0..1u64 << (3 * u32::from(d)) {
+                let (x, y, z) = demorton3(m);
+                coords.push(root.descendant(d, x, y, z));
+            }
+        }
+        let mut tiles = Bits::zeros(count);
+        for (n, t) in coords.iter().enumerate() {
+            let parent_ok = match t.level - root.level {
+                0 => true,
+                d => {
+                    let p = t.parent().expect("below the root");
+                    let pd = u32::from(d - 1);
+                    let (px, py, pz) = (p.x - (root.x << pd), p.y - (root.y << pd), p.z - (root.z << pd));
+                    tiles.get(octree_tiles(d - 1) as usize + implicit::morton3(px, py, pz) as usize)
+                }
+            };
+            if parent_ok && self.available(t) {
+                tiles.set(n);
+            }
+        }
+        (coords, tiles)
+    }
+
+    /// The child subtrees of the subtree rooted at `root` whose tiles are `tiles`: the tiles one
+    /// level below it that are available under an available tile, as bits and as roots.
+    fn children_of(&self, root: TileCoord, tiles: &Bits) -> (Bits, Vec<TileCoord>) {
+        let below = 1usize << (3 * u32::from(SUBTREE_LEVELS));
+        let mut children = Bits::zeros(below);
+        let mut roots = Vec::new();
+        let last = octree_tiles(SUBTREE_LEVELS - 1) as usize;
+        for m in 0..below as u64 {
+            let (x, y, z) = demorton3(m);
+            let t = root.descendant(SUBTREE_LEVELS, x, y, z);
+            if tiles.get(last + (m >> 3) as usize) && self.available(&t) {
+                children.set(m as usize);
+                roots.push(t);
+            }
+        }
+        (children, roots)
+    }
+
+    /// The roots of the available child subtrees of the subtree rooted at `root`, from the
+    /// availability alone (nothing is meshed).
+    pub fn child_subtrees(&self, root: TileCoord) -> Vec<TileCoord> {
+        let (_, tiles) = self.availability(root);
+        self.children_of(root, &tiles).1
+    }
+
+    /// An oriented box (3D Tiles `box`: centre, then three half-axis vectors) holding the face's
+    /// whole shell in ECEF. A direction of a face has its largest component along the face's
+    /// normal `n`, so its components along `u` and `v` are at most `1/√2` and along `n` at least
+    /// `1/√3`; the box is then grown by the frame's largest displacement.
+    pub fn face_box(&self, face: Face) -> [f64; 12] {
+        let l = self.tiling.layout();
+        let f = face.frame();
+        let (u, v, n) = (f.u.as_dvec3(), f.v.as_dvec3(), f.n.as_dvec3());
+        let r = l.radius() * (1.0 + 1e-9);
+        let inner = l.d_b() / 3f64.sqrt();
+        let centre = n * 0.5 * (inner + r);
+        // grown for the frame's displacement, and for the `f32` rounding of contents (a
+        // millionth of their spheres, which the face's shell holds)
+        let grow = self.frame.max_displacement() + 1e-6 * r;
+        let half = |axis: DVec3, len: f64| frame::to_ecef_axes(axis) * (len + grow);
+        let c = frame::to_ecef_axes(centre);
+        let (a, b, d) = (
+            half(u, r * std::f64::consts::FRAC_1_SQRT_2),
+            half(v, r * std::f64::consts::FRAC_1_SQRT_2),
+            half(n, 0.5 * (r - inner)),
+        );
+        [c.x, c.y, c.z, a.x, a.y, a.z, b.x, b.y, b.z, d.x, d.y, d.z]
+    }
+
+    /// The tileset JSON. `prefix` goes before every content and subtree URL (for example a
+    /// revision, `r12/`, so that a client fetching the tileset again after an edit finds new
+    /// URLs); `extras` are written under `extras.pmc`.
+    pub fn tileset_json(&self, prefix: &str, extras: Value) -> Value {
+        let top_error = (0..6)
+            .map(|f| self.geometric_error(&TileCoord::root(Face::ALL[f])))
+            .fold(0.0, f64::max);
+        let root_error = 2.0 * top_error.max(1.0);
+        let levels = self.available_levels();
+        let faces: Vec<Value> = Face::ALL
+            .into_iter()
+            .filter(|f| self.available(&TileCoord::root(*f)))
+            .map(|face| {
+                let name = face.name();
+                json!({
+                    "boundingVolume": {"box": self.face_box(face)},
+                    "geometricError": self.geometric_error(&TileCoord::root(face)),
+                    "refine": "REPLACE",
+                    "content": {"uri": format!("{prefix}content/{name}/{{level}}/{{x}}/{{y}}/{{z}}.glb")},
+                    "implicitTiling": {
+                        "subdivisionScheme": "OCTREE",
+                        "subtreeLevels": SUBTREE_LEVELS,
+                        "availableLevels": levels,
+                        "subtrees": {"uri": format!("{prefix}subtrees/{name}/{{level}}/{{x}}/{{y}}/{{z}}.subtree")},
+                    },
+                })
+            })
+            .collect();
+        let (_, planet_r) = self.frame.ball(DVec3::ZERO, self.tiling.layout().radius());
+        let mut extras_all = json!({
+            "frame": self.frame.name(),
+            "subtreeLevels": SUBTREE_LEVELS,
+            "virtualLevels": self.tiling.virtual_levels(),
+            "minLevel": self.options.min_level,
+        });
+        if let TileFrame::Wgs84 { datum } = self.frame {
+            extras_all["datum"] = json!(datum);
+        }
+        if let Value::Object(m) = extras {
+            for (k, v) in m {
+                extras_all[k] = v;
+            }
+        }
+        json!({
+            "asset": {"version": "1.1", "generator": self.generator},
+            "extras": {"pmc": extras_all},
+            "schema": {
+                "id": "pmc_tiles",
+                "classes": {
+                    "tile": {
+                        "description": "Per tile of a subtree: what the implicit subdivision of the face root's box cannot tell.",
+                        "properties": {
+                            "boundingSphere": {
+                                "type": "SCALAR",
+                                "componentType": "FLOAT64",
+                                "array": true,
+                                "count": 4,
+                                "semantic": "TILE_BOUNDING_SPHERE",
+                            },
+                            "geometricError": {
+                                "type": "SCALAR",
+                                "componentType": "FLOAT64",
+                                "semantic": "TILE_GEOMETRIC_ERROR",
+                            },
+                        },
+                    },
+                },
+            },
+            "geometricError": root_error,
+            "root": {
+                "boundingVolume": {"sphere": [0.0, 0.0, 0.0, planet_r]},
+                "geometricError": root_error,
+                "refine": "REPLACE",
+                "children": faces,
+            },
+        })
+    }
+}
