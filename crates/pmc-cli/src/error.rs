@@ -64,6 +64,10 @@ pub enum CliError {
     /// An invalid `--region` (or its level or error), or a region too large.
     #[error("invalid --region: {0}")]
     Region(String),
+    /// 3D Tiles could not be made (bad options, a folder holding something else, a write that
+    /// failed).
+    #[error(transparent)]
+    Tiles(#[from] pmc_tiles::TilesError),
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads: {reason}")]
     Threads {
@@ -94,6 +98,8 @@ impl CliError {
             CliError::World(_) | CliError::Brush(_) | CliError::Edit(_) | CliError::Dem(_) => 2,
             CliError::Imagery(e) if e.is_input_error() => 2,
             CliError::Imagery(_) => 1,
+            CliError::Tiles(pmc_tiles::TilesError::Io { .. } | pmc_tiles::TilesError::Content { .. }) => 1,
+            CliError::Tiles(_) => 2,
         }
     }
 }

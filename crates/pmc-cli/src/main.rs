@@ -25,6 +25,7 @@ mod path;
 mod planet_args;
 mod render;
 mod serve;
+mod tiles;
 mod work;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
@@ -61,6 +62,9 @@ enum Command {
     /// Imagery draped on a planet: import a colour image (JPEG, PNG, GeoTIFF) into a .pmcimg
     /// file for `pmc serve --imagery`, describe the file, look up its colour at a place.
     Imagery(imagery::ImageryArgs),
+    /// OGC 3D Tiles 1.1: bake a planet into a static tileset for CesiumJS and other 3D Tiles
+    /// clients (`pmc serve` also answers them live under /tiles/).
+    Tiles(tiles::TilesArgs),
 }
 
 /// Writes one line to standard output (see `outln!`).
@@ -100,6 +104,7 @@ fn main() -> ExitCode {
         Command::BenchFlight(a) => flight::run(a),
         Command::Dem(a) => dem::run(a),
         Command::Imagery(a) => imagery::run(a),
+        Command::Tiles(a) => tiles::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

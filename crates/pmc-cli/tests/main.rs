@@ -11,3 +11,4 @@ mod kill;
 mod path;
 mod region;
 mod serve;
+mod tiles;

@@ -9,7 +9,6 @@
 //! a bake never killed. Subtrees are baked depth first, a few at a time, each meshing its tiles
 //! on every core, so memory stays bounded at any depth.
 
-use crate::implicit::SUBTREE_LEVELS;
 use crate::{TileCoord, TileSet, TilesError};
 use pmc_geometry::Face;
 use rayon::prelude::*;
@@ -222,7 +221,6 @@ fn bake_one(tiles: &TileSet, folder: &Folder, root: TileCoord) -> Result<Done, T
         l.bytes += bytes.len() as u64;
     }
     folder.write(&rel, &built.subtree)?;
-    debug_assert!(root.level % SUBTREE_LEVELS == 0);
     Ok(Done {
         written: Some((levels, built.subtree.len() as u64)),
         children: built.children,

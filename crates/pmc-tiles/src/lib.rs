@@ -317,7 +317,7 @@ impl TileSet {
     /// availability of its tiles, the contents of those that have one (meshed in parallel), and
     /// the availability of its child subtrees. The same bytes every time, on any thread count.
     pub fn build_subtree(&self, root: TileCoord) -> Result<SubtreeBuild, TilesError> {
-        if root.level % SUBTREE_LEVELS != 0 {
+        if !root.level.is_multiple_of(SUBTREE_LEVELS) {
             return Err(TilesError::Invalid(format!(
                 "tile {}/{} is not the root of a subtree",
                 root.face,

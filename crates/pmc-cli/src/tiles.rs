@@ -1,0 +1,219 @@
+//! `pmc tiles bake`: a planet as a static OGC 3D Tiles 1.1 tileset (`docs/specs/tiles-v1.md`).
+
+use crate::error::CliError;
+use crate::planet_args::PlanetArgs;
+use crate::work;
+use clap::{Args, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pmc_planet::{Planet, TerrainSpec};
+use pmc_tiles::bake::BakeStats;
+use pmc_tiles::{Region, TileFrame, TileOptions, TileSet};
+use serde_json::{json, Value};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Options of `pmc tiles`.
+#[derive(Args, Debug)]
+pub struct TilesArgs {
+    #[command(subcommand)]
+    command: TilesCommand,
+}
+
+#[derive(Subcommand, Debug)]
+enum TilesCommand {
+    /// Bake a planet into a folder of 3D Tiles 1.1 (tileset.json, subtrees, glTF contents) that
+    /// any web server can host and CesiumJS loads. Resumable: run it again after an interrupt.
+    Bake(BakeArgs),
+}
+
+/// Where the tiles go in Earth-centred, Earth-fixed metres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FrameArg {
+    /// WGS84 for a planet of the Earth's size (within 1% of 6 371 km), else the sphere.
+    Auto,
+    /// Latitude, longitude and height above sea level laid on the WGS84 ellipsoid: lines up
+    /// with a globe's imagery and terrain.
+    Wgs84,
+    /// The planet's own sphere, rotated into ECEF axes.
+    Sphere,
+}
+
+/// Options of `pmc tiles bake`.
+#[derive(Args, Debug)]
+pub struct BakeArgs {
+    #[command(flatten)]
+    planet: PlanetArgs,
+
+    /// Bake the planet of this world file, with its edits (see `pmc edit`). The planet options
+    /// then come from the world and cannot be given.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "seed", "radius", "n_c", "n_t", "d_b", "l_d", "d_c", "dem"])]
+    world: Option<PathBuf>,
+
+    /// The folder to bake into: created if missing; a bake of the same tileset found there is
+    /// resumed; any other content is refused.
+    #[arg(short = 'o', long = "output", default_value = "tiles", value_name = "DIR")]
+    output: PathBuf,
+
+    /// The deepest tile level (0 is a cube face's root; the earth preset has levels 0 to 18,
+    /// level L holding chunks of level of detail 18 - L). Default: every level.
+    #[arg(long, value_name = "L")]
+    max_level: Option<u8>,
+
+    /// Tiles above this level are kept in the tree without content.
+    #[arg(long, value_name = "L", default_value_t = 0)]
+    min_level: u8,
+
+    /// Only the tiles near a place: within RADIUS_M metres of LAT,LON (degrees) at sea level.
+    #[arg(long, value_name = "LAT,LON,RADIUS_M", allow_hyphen_values = true)]
+    region: Option<String>,
+
+    /// Where the tiles are placed.
+    #[arg(long, value_enum, default_value = "auto")]
+    frame: FrameArg,
+
+    /// Worker threads; 0 uses every core. The output does not depend on it.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    threads: usize,
+
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// The planet's description in the tileset and the bake's manifest: its terrain (an elevation
+/// model by its content digest, not its path), layout and edits.
+pub fn planet_extras(planet: &Planet, edits: Option<usize>) -> Value {
+    let l = planet.layout();
+    let terrain = match &planet.terrain().spec {
+        TerrainSpec::Dem(d) => format!("dem:{}:{}:{}", d.interpolation, d.seed, d.digest),
+        spec => spec.to_string(),
+    };
+    let mut v = json!({
+        "terrain": terrain,
+        "layout": {"n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c()},
+        "datumRadius": planet.datum_radius(),
+    });
+    if let Some(n) = edits {
+        v["edits"] = json!(n);
+    }
+    v
+}
+
+/// The frame for `planet` given `--frame`.
+pub fn frame_for(planet: &Planet, arg: FrameArg) -> TileFrame {
+    let datum = planet.datum_radius();
+    match arg {
+        FrameArg::Auto => TileFrame::default_for(datum),
+        FrameArg::Wgs84 => TileFrame::Wgs84 { datum },
+        FrameArg::Sphere => TileFrame::Sphere,
+    }
+}
+
+fn parse_region(s: &str) -> Result<Region, CliError> {
+    let err = |why: String| CliError::Region(format!("{s}: {why}; give LAT,LON,RADIUS_M (degrees, degrees, metres)"));
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(err(format!("expected 3 numbers, got {}", parts.len())));
+    }
+    let num = |name: &str, t: &str| {
+        t.parse::<f64>()
+            .map_err(|_| err(format!("the {name} {t:?} is not a number")))
+    };
+    Ok(Region {
+        lat: num("latitude", parts[0])?,
+        lon: num("longitude", parts[1])?,
+        radius: num("radius", parts[2])?,
+    })
+}
+
+/// Runs `pmc tiles`.
+pub fn run(args: &TilesArgs) -> Result<(), CliError> {
+    match &args.command {
+        TilesCommand::Bake(b) => bake(b),
+    }
+}
+
+fn bake(args: &BakeArgs) -> Result<(), CliError> {
+    let (planet, edits) = match &args.world {
+        Some(path) => {
+            let world = pmc_world::World::open(path)?;
+            let n = world.active_edits()?.len();
+            (crate::edit::planet_of(&world)?, Some(n))
+        }
+        None => (args.planet.planet()?, None),
+    };
+    let region = args.region.as_deref().map(parse_region).transpose()?;
+    let frame = frame_for(&planet, args.frame);
+    let pool = work::thread_pool(args.threads)?;
+    let extras = planet_extras(&planet, edits);
+    let planet = Arc::new(planet);
+    let quiet = args.quiet;
+    let start = Instant::now();
+    let say = |s: &str| {
+        if !quiet {
+            eprintln!("{s}");
+        }
+    };
+    say("measuring the geometric error of each level of detail");
+    let errors = pool.install(|| pmc_lod::measure_level_errors(&planet, 1024, 0x5eed));
+    let options = TileOptions {
+        max_level: args.max_level,
+        min_level: args.min_level,
+        region,
+    };
+    let generator = format!("pmc {}", env!("CARGO_PKG_VERSION"));
+    let tiles = TileSet::new(planet, errors, frame, options, &generator)?;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr())
+    };
+    bar.set_style(ProgressStyle::with_template("{spinner} baking {msg} ({elapsed})").expect("valid template"));
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let progress = |s: &BakeStats| {
+        bar.set_message(format!(
+            "{} subtrees, {} tiles, {:.1} MB{}",
+            s.subtrees + s.resumed,
+            s.tiles(),
+            s.bytes() as f64 / 1e6,
+            if s.resumed > 0 {
+                format!(" ({} subtrees already baked)", s.resumed)
+            } else {
+                String::new()
+            }
+        ));
+    };
+    let stats = pool.install(|| pmc_tiles::bake::bake(&tiles, &args.output, extras, &progress))?;
+    bar.finish_and_clear();
+    let secs = start.elapsed().as_secs_f64();
+    if !quiet {
+        outln!(
+            "baked {} tiles ({:.1} MB, {} subtrees{}) into {} in {secs:.1} s, {:.0} tiles/s; frame {}",
+            stats.tiles(),
+            stats.bytes() as f64 / 1e6,
+            stats.subtrees,
+            if stats.resumed > 0 {
+                format!(", {} resumed", stats.resumed)
+            } else {
+                String::new()
+            },
+            args.output.display(),
+            stats.tiles() as f64 / secs.max(1e-9),
+            tiles.frame().name(),
+        );
+        for (level, l) in stats.levels.iter().enumerate().filter(|(_, l)| l.tiles > 0) {
+            outln!(
+                "  level {level:>2}: {:>8} tiles {:>10.2} MB ({:.1} KB a tile)",
+                l.tiles,
+                l.bytes as f64 / 1e6,
+                l.bytes as f64 / 1e3 / l.tiles as f64
+            );
+        }
+        outln!(
+            "host the folder with any web server and load {} (CesiumJS: Cesium3DTileset.fromUrl)",
+            args.output.join("tileset.json").display()
+        );
+    }
+    Ok(())
+}
