@@ -61,6 +61,16 @@ pub struct ServeArgs {
     /// viewer colours the terrain from it (GET /api/v1/imagery).
     #[arg(long, value_name = "FILE.pmcimg")]
     imagery: Option<PathBuf>,
+
+    /// Where the OGC 3D Tiles at /tiles/tileset.json are placed: auto (WGS84 for a planet of the
+    /// Earth's size, else its sphere), wgs84 or sphere.
+    #[arg(long = "tiles-frame", value_enum, default_value = "auto")]
+    tiles_frame: crate::tiles::FrameArg,
+
+    /// CesiumJS's built files (npm's cesium/Build/Cesium): the CesiumJS example page at /cesium/
+    /// then shows the planet's 3D Tiles (./scripts/run.sh installs it in examples/cesium).
+    #[arg(long = "cesium-js", value_name = "DIR")]
+    cesium_js: Option<PathBuf>,
 }
 
 /// Parses `--host`: an IP address or "localhost" (no name lookups).
@@ -95,6 +105,12 @@ pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliErro
         threads: args.threads,
         world: args.world.clone(),
         imagery: args.imagery.clone(),
+        tiles_frame: match args.tiles_frame {
+            crate::tiles::FrameArg::Auto => pmc_server::tiles_api::TilesFrame::Auto,
+            crate::tiles::FrameArg::Wgs84 => pmc_server::tiles_api::TilesFrame::Wgs84,
+            crate::tiles::FrameArg::Sphere => pmc_server::tiles_api::TilesFrame::Sphere,
+        },
+        cesium_js: args.cesium_js.clone(),
         edit_limits: EditLimits {
             max_brush_radius: args.max_brush_radius,
             rate_per_second: args.edit_rate,
@@ -117,6 +133,9 @@ pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliErro
         let mut out = std::io::stdout().lock();
         // The URL line is what scripts and tests wait for; a closed stdout is no reason to stop.
         let _ = writeln!(out, "PMC viewer: {}", server.url());
+        if server.state().config().cesium_js.is_some() {
+            let _ = writeln!(out, "CesiumJS (3D Tiles): {}cesium/", server.url());
+        }
         let _ = out.flush();
         drop(out);
         server.run(pmc_server::shutdown_signal()).await

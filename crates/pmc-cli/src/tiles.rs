@@ -5,10 +5,9 @@ use crate::planet_args::PlanetArgs;
 use crate::work;
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pmc_planet::{Planet, TerrainSpec};
+use pmc_planet::Planet;
 use pmc_tiles::bake::BakeStats;
 use pmc_tiles::{Region, TileFrame, TileOptions, TileSet};
-use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -81,25 +80,6 @@ pub struct BakeArgs {
     quiet: bool,
 }
 
-/// The planet's description in the tileset and the bake's manifest: its terrain (an elevation
-/// model by its content digest, not its path), layout and edits.
-pub fn planet_extras(planet: &Planet, edits: Option<usize>) -> Value {
-    let l = planet.layout();
-    let terrain = match &planet.terrain().spec {
-        TerrainSpec::Dem(d) => format!("dem:{}:{}:{}", d.interpolation, d.seed, d.digest),
-        spec => spec.to_string(),
-    };
-    let mut v = json!({
-        "terrain": terrain,
-        "layout": {"n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c()},
-        "datumRadius": planet.datum_radius(),
-    });
-    if let Some(n) = edits {
-        v["edits"] = json!(n);
-    }
-    v
-}
-
 /// The frame for `planet` given `--frame`.
 pub fn frame_for(planet: &Planet, arg: FrameArg) -> TileFrame {
     let datum = planet.datum_radius();
@@ -146,7 +126,7 @@ fn bake(args: &BakeArgs) -> Result<(), CliError> {
     let region = args.region.as_deref().map(parse_region).transpose()?;
     let frame = frame_for(&planet, args.frame);
     let pool = work::thread_pool(args.threads)?;
-    let extras = planet_extras(&planet, edits);
+    let extras = pmc_tiles::planet_extras(&planet, edits);
     let planet = Arc::new(planet);
     let quiet = args.quiet;
     let start = Instant::now();

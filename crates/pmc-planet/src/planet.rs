@@ -375,6 +375,21 @@ impl Planet {
         !(a == b && a != Known::Unknown)
     }
 
+    /// Whether chunk `key` holds no surface by the planet's bounds alone, without sampling:
+    /// outside the density's radial bounds ([`Planet::may_hold_surface`]), or every sample of
+    /// its batch of one sign by [`Density::uniform_sign`] (the shell's closure included). Such a
+    /// chunk meshes to nothing at its level. (A finer level samples between its samples and may
+    /// find what they miss.)
+    pub fn holds_no_surface_by_bound(&self, key: &ChunkKey) -> bool {
+        if !self.may_hold_surface(key) {
+            return true;
+        }
+        if self.heightfield.is_some() {
+            return false;
+        }
+        self.uniform_by_bound(&ChunkGrid::new(&self.layout, *key))
+    }
+
     /// Whether the chunk of `grid` holds no surface by the density's own bound: every sample of
     /// its batch has one sign ([`Density::uniform_sign`]), and the shell's closure forces none of
     /// its layers to the other (layers at depth index `<= 0` are made solid, `>= depth` air).

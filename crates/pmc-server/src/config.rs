@@ -71,6 +71,11 @@ pub struct ServerConfig {
     /// `/api/v1/imagery` and described in `/api/v1/planet`; read and checked at start. `None`:
     /// no imagery.
     pub imagery: Option<PathBuf>,
+    /// Where the 3D Tiles of `/tiles/` are placed (`docs/specs/tiles-v1.md`).
+    pub tiles_frame: crate::tiles_api::TilesFrame,
+    /// CesiumJS's built files (npm's `cesium/Build/Cesium`), served at `/cesium/Cesium/` under
+    /// the example page at `/cesium/`. `None`: no CesiumJS page.
+    pub cesium_js: Option<PathBuf>,
 }
 
 /// How a server meshes its planet.
@@ -100,6 +105,8 @@ impl Default for ServerConfig {
             base_cache_chunks: 256,
             mesher: Mesher::Volumetric,
             imagery: None,
+            tiles_frame: crate::tiles_api::TilesFrame::Auto,
+            cesium_js: None,
         }
     }
 }
@@ -127,6 +134,15 @@ impl ServerConfig {
                     "a height field cannot be edited: serve a world with the volumetric mesher (leave --mesher out)"
                         .into(),
                 ));
+            }
+        }
+        if let Some(dir) = &self.cesium_js {
+            if !dir.join("Cesium.js").is_file() {
+                return Err(ServerError::Config(format!(
+                    "--cesium-js {}: no Cesium.js there; give npm's cesium/Build/Cesium folder (run `npm ci` in \
+                     examples/cesium, then --cesium-js examples/cesium/node_modules/cesium/Build/Cesium)",
+                    dir.display()
+                )));
             }
         }
         let e = &self.edit_limits;

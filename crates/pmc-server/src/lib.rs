@@ -15,6 +15,8 @@
 //!   for once), each with its cached chunks.
 //! - `/chunks` finds the chunks near a point with a quadtree per face over provable bounding
 //!   spheres (see [`pmc_lod::bounds`]), so it stays fast on planets of any size.
+//! - `/tiles/` answers OGC 3D Tiles 1.1 of the planet for CesiumJS and other clients
+//!   ([`tiles_api`], `docs/specs/tiles-v1.md`), built subtree by subtree on demand and cached.
 //! - Every malformed request gets a 4xx with a JSON `{"error": ...}`; no request can panic the
 //!   server.
 //!
@@ -30,6 +32,7 @@
 pub mod api;
 pub mod assets;
 pub mod batch_api;
+pub mod cesium;
 mod chunk_cache;
 mod config;
 pub mod edit_api;
@@ -45,6 +48,7 @@ pub mod relief_api;
 mod request;
 mod server;
 mod state;
+pub mod tiles_api;
 
 pub use config::{EditLimits, Mesher, ServerConfig};
 pub use error::ServerError;

@@ -1,6 +1,9 @@
 //! The router, listening, and shutdown.
 
-use crate::{api, assets, batch_api, edit_api, imagery_api, nav_api, relief_api, AppState, ServerConfig, ServerError};
+use crate::{
+    api, assets, batch_api, cesium, edit_api, imagery_api, nav_api, relief_api, tiles_api, AppState, ServerConfig,
+    ServerError,
+};
 use axum::extract::Request;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
@@ -59,6 +62,14 @@ pub fn router(state: AppState) -> Router {
         .route("/api/v1/events", get(edit_api::events))
         .route("/api/v1/path", get(nav_api::path))
         .route("/api/v1/navgrid", get(nav_api::navgrid))
+        .route("/tiles/tileset.json", get(tiles_api::tileset_json))
+        .route("/cesium", get(cesium::redirect))
+        .route("/cesium/", get(cesium::page))
+        .route("/cesium/Cesium/{*path}", get(cesium::file))
+        .route(
+            "/tiles/{rev}/{kind}/{face}/{level}/{x}/{y}/{file}",
+            get(tiles_api::tile_file),
+        )
         .route("/api", any(api::not_found))
         .route("/api/", any(api::not_found))
         .route("/api/{*rest}", any(api::not_found))

@@ -29,6 +29,8 @@ struct Inner {
     navs: std::sync::Mutex<std::collections::VecDeque<NavEntry>>,
     /// Set when the server begins to stop: long-lived answers (the event streams) end.
     stopping: tokio::sync::watch::Sender<bool>,
+    /// The 3D Tiles of the default planet.
+    tiles: crate::tiles_api::ServedTiles,
     /// Measured level-of-detail errors (metres per level) by planet, computed once each.
     lod_errors: std::sync::Mutex<std::collections::HashMap<PlanetId, Arc<Vec<f64>>>>,
 }
@@ -196,6 +198,16 @@ impl AppState {
                 relief,
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
                 lod_errors: std::sync::Mutex::new(std::collections::HashMap::new()),
+                // a quarter of the chunk cache's bytes for built subtrees and their contents
+                tiles: crate::tiles_api::ServedTiles::new(
+                    config.tiles_frame,
+                    config.cache_bytes / 4,
+                    if config.threads == 0 {
+                        std::thread::available_parallelism().map_or(2, |n| n.get())
+                    } else {
+                        config.threads
+                    },
+                ),
                 stopping: tokio::sync::watch::Sender::new(false),
                 config,
             }),
@@ -241,6 +253,11 @@ impl AppState {
                 reused_shading: jobs.reused,
             },
         }
+    }
+
+    /// The 3D Tiles of the default planet.
+    pub(crate) fn tiles(&self) -> &crate::tiles_api::ServedTiles {
+        &self.inner.tiles
     }
 
     /// The imagery draped on the default planet, if the server has one.

@@ -1,6 +1,6 @@
 //! Baking a tileset to a folder any web server can host, resumably.
 //!
-//! The folder holds `tileset.json`, `subtrees/FACE/LEVEL/X/Y/Z.subtree`,
+//! The folder holds `tileset.json`, `subtrees/FACE/LEVEL/X/Y/Z.json`,
 //! `content/FACE/LEVEL/X/Y/Z.glb` and `bake.json` (what was baked, so that a bake resumed into
 //! the folder is the same one). Every file is written under `.partial/` and renamed into place,
 //! so no file in the tileset is ever half-written; `.partial/` is emptied when a bake starts. A
@@ -16,7 +16,7 @@ use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Per implicit level: tiles with content, and their bytes.
+/// Per tile level: tiles with content, and their bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LevelStats {
     /// Tiles with content written at this level.
@@ -32,7 +32,7 @@ pub struct BakeStats {
     pub subtrees: u64,
     /// Subtrees found already baked (a resumed bake).
     pub resumed: u64,
-    /// Tile contents written, per implicit level.
+    /// Tile contents written, per tile level.
     pub levels: Vec<LevelStats>,
     /// Bytes of subtree files written.
     pub subtree_bytes: u64,
@@ -81,7 +81,7 @@ impl Folder {
 
 /// The subtree file of a subtree root, relative to the folder.
 pub fn subtree_path(t: &TileCoord) -> String {
-    format!("subtrees/{}/{}.subtree", t.face.name(), t.path())
+    format!("subtrees/{}/{}.json", t.face.name(), t.path())
 }
 
 /// The content file of a tile, relative to the folder.

@@ -1,15 +1,19 @@
 //! OGC 3D Tiles 1.1 for planetary marching cubes (`docs/specs/tiles-v1.md`).
 //!
-//! A planet becomes one tileset: an explicit root over six implicit octrees, one per cube face,
-//! whose tiles are the face's chunks of every level ([`implicit`]). Each tile's content is its
-//! chunk *closed* (`pmc_planet::Planet::chunk_mesh_closed`): the surface plus caps on the
-//! chunk's six sides, so a client may put any level beside any other and still show no inside
-//! of a solid through the crack between them (the argument is in `pmc_mesh::caps`). Tiles are
-//! placed in Earth-centred, Earth-fixed metres on the WGS84 ellipsoid or on the planet's sphere
-//! ([`frame`]). Each subtree file carries, per available tile, its bounding sphere and geometric
-//! error as tile metadata (the `TILE_BOUNDING_SPHERE` and `TILE_GEOMETRIC_ERROR` semantics): a
-//! chunk of the cube sphere is not a box of the face root's implicit subdivision, so a client
-//! must read them (CesiumJS does).
+//! A planet becomes one tileset: a root over six octrees, one per cube face, whose tiles are the
+//! face's chunks of every level ([`octree`]: tile level 0 is the face's coarsest chunk). Each
+//! tile's content is its chunk *closed* (`pmc_planet::Planet::chunk_mesh_closed`): the surface
+//! plus caps on the chunk's six sides, so a client may put any level beside any other and still
+//! show no inside of a solid through the crack between them (the argument is in
+//! `pmc_mesh::caps`). Tiles are placed in Earth-centred, Earth-fixed metres on the WGS84
+//! ellipsoid or on the planet's sphere ([`frame`]), with provable bounding spheres.
+//!
+//! The tree is written explicitly, three levels to a file: each *subtree file* is an external
+//! tileset whose root is a chunk, holding the tiles of its levels and, under the deepest, one
+//! tile per child subtree whose content is that subtree's file. (3D Tiles' implicit tiling cannot
+//! carry this tree: a client derives the volume of each child subtree's root by halving the face
+//! root's box, and culls the subtree by that volume before it reads its metadata; a chunk of the
+//! cube sphere is no such half, so whole subtrees were culled in CesiumJS.)
 //!
 //! A [`TileSet`] answers the tileset JSON ([`TileSet::tileset_json`]) and builds one subtree at a
 //! time with its tiles' contents ([`TileSet::build_subtree`]): the unit of work of a bake
@@ -19,22 +23,22 @@
 
 pub mod bake;
 pub mod frame;
-pub mod implicit;
+pub mod octree;
 pub mod subtree;
 
 pub use frame::TileFrame;
-pub use implicit::{TileCoord, Tiling, SUBTREE_LEVELS};
+pub use octree::{TileCoord, Tiling, SUBTREE_LEVELS};
 
-use implicit::{demorton3, octree_tiles};
+use octree::{demorton3, octree_tiles};
 use pmc_geometry::glam::DVec3;
 use pmc_geometry::{ChunkKey, Face, LatLon};
 use pmc_mesh::ChunkMesh;
-use pmc_planet::{ChunkScratch, Planet};
+use pmc_planet::{ChunkScratch, Planet, TerrainSpec};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::cell::RefCell;
 use std::sync::Arc;
-use subtree::{Bits, Subtree};
+use subtree::Bits;
 
 /// What can go wrong building tiles.
 #[derive(Debug, thiserror::Error)]
@@ -86,9 +90,9 @@ pub struct Region {
 /// Which tiles a tileset holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TileOptions {
-    /// The deepest implicit level (0 is a face's root); `None` for every level of detail.
+    /// The deepest tile level (0 is a face's root); `None` for every level of detail.
     pub max_level: Option<u8>,
-    /// Tiles above this implicit level have no content (they stay in the tree as its path).
+    /// Tiles above this tile level have no content (they stay in the tree as its path).
     pub min_level: u8,
     /// Only the tiles meeting this region (and the path to them).
     pub region: Option<Region>,
@@ -123,6 +127,26 @@ thread_local! {
     static SCRATCH: RefCell<ChunkScratch> = RefCell::new(ChunkScratch::default());
 }
 
+/// A planet's description for a tileset's `extras.pmc` and a bake's manifest: its terrain (an
+/// elevation model by its content digest, not its path), its layout, its datum radius and, for
+/// a world, how many edits it holds.
+pub fn planet_extras(planet: &Planet, edits: Option<usize>) -> Value {
+    let l = planet.layout();
+    let terrain = match &planet.terrain().spec {
+        TerrainSpec::Dem(d) => format!("dem:{}:{}:{}", d.interpolation, d.seed, d.digest),
+        spec => spec.to_string(),
+    };
+    let mut v = json!({
+        "terrain": terrain,
+        "layout": {"n_c": l.n_c(), "n_t": l.n_t(), "d_b": l.d_b(), "l_d": l.l_d(), "d_c": l.d_c()},
+        "datumRadius": planet.datum_radius(),
+    });
+    if let Some(n) = edits {
+        v["edits"] = json!(n);
+    }
+    v
+}
+
 /// The glTF coordinates of an ECEF vector: 3D Tiles turns glTF's Y-up into Z-up by
 /// `(x, y, z) -> (x, -z, y)`, so glTF holds `(X, Z, -Y)`.
 fn gltf_axes(e: DVec3) -> DVec3 {
@@ -154,7 +178,7 @@ impl TileSet {
         if let Some(m) = options.max_level {
             if m >= tiling.levels() {
                 return Err(TilesError::Invalid(format!(
-                    "--max-level {m}: this planet's tiles have implicit levels 0 to {}",
+                    "--max-level {m}: this planet's tiles have levels 0 to {}",
                     tiling.levels() - 1
                 )));
             }
@@ -205,7 +229,7 @@ impl TileSet {
         &self.tiling
     }
 
-    /// Implicit levels in the tileset (`availableLevels`).
+    /// Tile levels in the tileset.
     pub fn available_levels(&self) -> u8 {
         self.options.max_level.map_or(self.tiling.levels(), |m| m + 1)
     }
@@ -246,8 +270,12 @@ impl TileSet {
     }
 
     /// Whether the tile is in the tileset, its parent being in it: it exists, is within the
-    /// levels asked for and meets the region, and its chunk may hold surface by the planet's
-    /// radial bounds (a sound test: no descendant of a tile that fails it holds surface).
+    /// levels asked for and meets the region, and its chunk is not known to hold no surface
+    /// (`Planet::holds_no_surface_by_bound`: outside the radial bounds, or every sample of one
+    /// sign). So the tree follows the surface: air and rock end their branches, and a client
+    /// never walks a subtree with nothing to draw. A feature smaller than a level's voxels
+    /// inside a chunk whose every sample is of one sign (a small cave deep in rock) is not
+    /// reached through that chunk.
     pub fn available(&self, t: &TileCoord) -> bool {
         if t.level >= self.available_levels() || !self.tiling.exists(t) {
             return false;
@@ -259,7 +287,7 @@ impl TileSet {
             }
         }
         match self.tiling.key(t) {
-            Some(key) => self.planet.may_hold_surface(&key),
+            Some(key) => !self.planet.holds_no_surface_by_bound(&key),
             None => true,
         }
     }
@@ -313,9 +341,11 @@ impl TileSet {
         Ok(Some(out))
     }
 
-    /// Builds the subtree rooted at `root` (a tile at a multiple of [`SUBTREE_LEVELS`]): the
-    /// availability of its tiles, the contents of those that have one (meshed in parallel), and
-    /// the availability of its child subtrees. The same bytes every time, on any thread count.
+    /// Builds the subtree file rooted at `root` (a tile at a multiple of [`SUBTREE_LEVELS`]): an
+    /// external tileset whose root is `root`, holding the available tiles of its levels with
+    /// their bounding spheres, geometric errors and contents (meshed in parallel), and, under its
+    /// deepest tiles, one tile per available child subtree whose content is that subtree's file.
+    /// The same bytes every time, on any thread count.
     pub fn build_subtree(&self, root: TileCoord) -> Result<SubtreeBuild, TilesError> {
         if !root.level.is_multiple_of(SUBTREE_LEVELS) {
             return Err(TilesError::Invalid(format!(
@@ -336,30 +366,56 @@ impl TileSet {
                 }
             })
             .collect::<Result<_, _>>()?;
-        let mut content = Bits::zeros(count);
-        let (mut spheres, mut errors) = (Vec::new(), Vec::new());
-        for (n, t) in coords.iter().enumerate() {
+        let (_, child_roots) = self.children_of(root, &tiles);
+        // URLs are relative to the subtree file, `subtrees/FACE/LEVEL/X/Y/Z.json`.
+        let up = "../../../../../";
+        let index: std::collections::HashMap<TileCoord, usize> =
+            coords.iter().enumerate().map(|(n, t)| (*t, n)).collect();
+        let node = |t: &TileCoord| -> Value {
+            let (c, r) = self.sphere(t);
+            json!({"boundingVolume": {"sphere": [c.x, c.y, c.z, r]}, "geometricError": self.geometric_error(t)})
+        };
+        // Deepest first, so a tile's children are made before it.
+        let mut made: Vec<Option<Value>> = vec![None; count];
+        for n in (0..count).rev() {
+            if !tiles.get(n) {
+                continue;
+            }
+            let t = coords[n];
+            let mut v = node(&t);
             if contents[n].is_some() {
-                content.set(n);
+                v["content"] = json!({"uri": format!("{up}content/{}/{}.glb", t.face.name(), t.path())});
             }
-            if tiles.get(n) {
-                let (c, r) = self.sphere(t);
-                spheres.push([c.x, c.y, c.z, r]);
-                errors.push(self.geometric_error(t));
+            let mut children = Vec::new();
+            if t.level + 1 < root.level + SUBTREE_LEVELS {
+                for m in 0..8u32 {
+                    let c = t.descendant(1, m & 1, m >> 1 & 1, m >> 2 & 1);
+                    if let Some(c) = index.get(&c).and_then(|&i| made[i].take()) {
+                        children.push(c);
+                    }
+                }
+            } else {
+                for c in child_roots.iter().filter(|c| c.parent() == Some(t)) {
+                    let mut v = node(c);
+                    v["content"] = json!({"uri": format!("{up}subtrees/{}/{}.json", c.face.name(), c.path())});
+                    children.push(v);
+                }
             }
+            if !children.is_empty() {
+                v["children"] = Value::Array(children);
+            }
+            made[n] = Some(v);
         }
-        let (children, child_roots) = self.children_of(root, &tiles);
+        let mut top = made[0].take().unwrap_or_else(|| node(&root));
+        top["refine"] = json!("REPLACE");
+        let doc = json!({
+            "asset": {"version": "1.1", "generator": self.generator},
+            "geometricError": self.geometric_error(&root),
+            "root": top,
+        });
         let available = tiles.count();
-        let subtree = Subtree {
-            tiles,
-            content,
-            children,
-            spheres,
-            errors,
-        }
-        .to_bytes();
         Ok(SubtreeBuild {
-            subtree,
+            subtree: serde_json::to_vec(&doc).expect("JSON serialises"),
             contents: coords
                 .into_iter()
                 .zip(contents)
@@ -389,7 +445,7 @@ impl TileSet {
                     let p = t.parent().expect("below the root");
                     let pd = u32::from(d - 1);
                     let (px, py, pz) = (p.x - (root.x << pd), p.y - (root.y << pd), p.z - (root.z << pd));
-                    tiles.get(octree_tiles(d - 1) as usize + implicit::morton3(px, py, pz) as usize)
+                    tiles.get(octree_tiles(d - 1) as usize + octree::morton3(px, py, pz) as usize)
                 }
             };
             if parent_ok && self.available(t) {
@@ -424,55 +480,24 @@ impl TileSet {
         self.children_of(root, &tiles).1
     }
 
-    /// An oriented box (3D Tiles `box`: centre, then three half-axis vectors) holding the face's
-    /// whole shell in ECEF. A direction of a face has its largest component along the face's
-    /// normal `n`, so its components along `u` and `v` are at most `1/√2` and along `n` at least
-    /// `1/√3`; the box is then grown by the frame's largest displacement.
-    pub fn face_box(&self, face: Face) -> [f64; 12] {
-        let l = self.tiling.layout();
-        let f = face.frame();
-        let (u, v, n) = (f.u.as_dvec3(), f.v.as_dvec3(), f.n.as_dvec3());
-        let r = l.radius() * (1.0 + 1e-9);
-        let inner = l.d_b() / 3f64.sqrt();
-        let centre = n * 0.5 * (inner + r);
-        // grown for the frame's displacement, and for the `f32` rounding of contents (a
-        // millionth of their spheres, which the face's shell holds)
-        let grow = self.frame.max_displacement() + 1e-6 * r;
-        let half = |axis: DVec3, len: f64| frame::to_ecef_axes(axis) * (len + grow);
-        let c = frame::to_ecef_axes(centre);
-        let (a, b, d) = (
-            half(u, r * std::f64::consts::FRAC_1_SQRT_2),
-            half(v, r * std::f64::consts::FRAC_1_SQRT_2),
-            half(n, 0.5 * (r - inner)),
-        );
-        [c.x, c.y, c.z, a.x, a.y, a.z, b.x, b.y, b.z, d.x, d.y, d.z]
-    }
-
-    /// The tileset JSON. `prefix` goes before every content and subtree URL (for example a
-    /// revision, `r12/`, so that a client fetching the tileset again after an edit finds new
-    /// URLs); `extras` are written under `extras.pmc`.
+    /// The tileset JSON. `prefix` goes before every subtree URL (for example a revision,
+    /// `r12/`, so that a client fetching the tileset again after an edit finds new URLs);
+    /// `extras` are written under `extras.pmc`. Its root holds the six faces' roots, each an
+    /// external tileset: the face's first subtree file.
     pub fn tileset_json(&self, prefix: &str, extras: Value) -> Value {
-        let top_error = (0..6)
-            .map(|f| self.geometric_error(&TileCoord::root(Face::ALL[f])))
-            .fold(0.0, f64::max);
-        let root_error = 2.0 * top_error.max(1.0);
-        let levels = self.available_levels();
+        // Drawing nothing misses the whole planet: the root's error is the planet's radius, so
+        // a client refines it at any distance from which the planet shows.
+        let root_error = self.tiling.layout().radius();
         let faces: Vec<Value> = Face::ALL
             .into_iter()
-            .filter(|f| self.available(&TileCoord::root(*f)))
-            .map(|face| {
-                let name = face.name();
+            .map(TileCoord::root)
+            .filter(|t| self.available(t))
+            .map(|t| {
+                let (c, r) = self.sphere(&t);
                 json!({
-                    "boundingVolume": {"box": self.face_box(face)},
-                    "geometricError": self.geometric_error(&TileCoord::root(face)),
-                    "refine": "REPLACE",
-                    "content": {"uri": format!("{prefix}content/{name}/{{level}}/{{x}}/{{y}}/{{z}}.glb")},
-                    "implicitTiling": {
-                        "subdivisionScheme": "OCTREE",
-                        "subtreeLevels": SUBTREE_LEVELS,
-                        "availableLevels": levels,
-                        "subtrees": {"uri": format!("{prefix}subtrees/{name}/{{level}}/{{x}}/{{y}}/{{z}}.subtree")},
-                    },
+                    "boundingVolume": {"sphere": [c.x, c.y, c.z, r]},
+                    "geometricError": self.geometric_error(&t),
+                    "content": {"uri": format!("{prefix}subtrees/{}/{}.json", t.face.name(), t.path())},
                 })
             })
             .collect();
@@ -480,6 +505,7 @@ impl TileSet {
         let mut extras_all = json!({
             "frame": self.frame.name(),
             "subtreeLevels": SUBTREE_LEVELS,
+            "levels": self.available_levels(),
             "virtualLevels": self.tiling.virtual_levels(),
             "minLevel": self.options.min_level,
         });
@@ -494,28 +520,6 @@ impl TileSet {
         json!({
             "asset": {"version": "1.1", "generator": self.generator},
             "extras": {"pmc": extras_all},
-            "schema": {
-                "id": "pmc_tiles",
-                "classes": {
-                    "tile": {
-                        "description": "Per tile of a subtree: what the implicit subdivision of the face root's box cannot tell.",
-                        "properties": {
-                            "boundingSphere": {
-                                "type": "SCALAR",
-                                "componentType": "FLOAT64",
-                                "array": true,
-                                "count": 4,
-                                "semantic": "TILE_BOUNDING_SPHERE",
-                            },
-                            "geometricError": {
-                                "type": "SCALAR",
-                                "componentType": "FLOAT64",
-                                "semantic": "TILE_GEOMETRIC_ERROR",
-                            },
-                        },
-                    },
-                },
-            },
             "geometricError": root_error,
             "root": {
                 "boundingVolume": {"sphere": [0.0, 0.0, 0.0, planet_r]},

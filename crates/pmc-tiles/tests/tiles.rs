@@ -5,8 +5,7 @@ use pmc_geometry::glam::DVec3;
 use pmc_geometry::{Face, Layout};
 use pmc_planet::{Planet, PresetKind};
 use pmc_tiles::bake::{bake, content_path, subtree_path, BakeStats};
-use pmc_tiles::implicit::{demorton3, morton3, octree_tiles};
-use pmc_tiles::subtree::Subtree;
+use pmc_tiles::octree::{demorton3, morton3, octree_tiles};
 use pmc_tiles::{Region, TileCoord, TileFrame, TileOptions, TileSet, TilesError, Tiling, SUBTREE_LEVELS};
 use proptest::prelude::*;
 use serde_json::{json, Value};
@@ -264,9 +263,6 @@ fn every_tile_lies_in_its_sphere_and_its_ancestors_spheres() {
         let subtrees = all_subtrees(&tiles);
         let mut contents = 0;
         for b in subtrees.values() {
-            let st = Subtree::from_bytes(&b.subtree, 73, 512).unwrap();
-            assert_eq!(st.spheres.len(), st.tiles.count());
-            assert_eq!(st.errors.len(), st.tiles.count());
             for (t, glb) in &b.contents {
                 contents += 1;
                 let (doc, pts) = glb_positions(glb);
@@ -288,38 +284,73 @@ fn every_tile_lies_in_its_sphere_and_its_ancestors_spheres() {
     }
 }
 
+/// The tile a subtree file's URL names (`../../../../../KIND/FACE/L/X/Y/Z.EXT`).
+fn tile_of(uri: &str) -> (String, TileCoord) {
+    let parts: Vec<&str> = uri.trim_start_matches("../../../../../").split('/').collect();
+    let n = |i: usize| parts[i].split('.').next().unwrap().parse::<u32>().unwrap();
+    let face = Face::ALL.into_iter().find(|f| f.name() == parts[1]).unwrap();
+    let t = TileCoord {
+        face,
+        level: n(2) as u8,
+        x: n(3),
+        y: n(4),
+        z: n(5),
+    };
+    (parts[0].to_string(), t)
+}
+
+/// Every node of a subtree file with the tile its content's URL names (the root's for a node
+/// without content, which the checks skip), and whether it stands for a child subtree.
+fn walk(node: &Value, root: TileCoord, out: &mut Vec<(TileCoord, Value, bool)>) {
+    let (t, is_subtree) = match node["content"]["uri"].as_str().map(tile_of) {
+        Some((kind, t)) => (t, kind == "subtrees"),
+        None => (root, false),
+    };
+    out.push((t, node.clone(), is_subtree));
+    for c in node["children"].as_array().into_iter().flatten() {
+        walk(c, root, out);
+    }
+}
+
 #[test]
-fn subtrees_say_what_the_contents_are() {
+fn subtree_files_hold_their_tiles_spheres_errors_and_contents() {
     let tiles = small_tiles(TileFrame::Sphere, TileOptions::default());
     for (root, b) in all_subtrees(&tiles) {
-        let st = Subtree::from_bytes(&b.subtree, 73, 512).unwrap();
-        assert_eq!(st.tiles.count(), b.available);
-        let with_content: Vec<TileCoord> = b.contents.iter().map(|c| c.0).collect();
-        let mut n = 0;
-        for d in 0..SUBTREE_LEVELS {
-            for m in 0..1u64 << (3 * u32::from(d)) {
-                let (x, y, z) = demorton3(m);
-                let t = root.descendant(d, x, y, z);
-                assert_eq!(st.content.get(n), with_content.contains(&t), "{t:?}");
-                if st.content.get(n) {
-                    assert!(st.tiles.get(n), "content only on available tiles");
-                }
-                if st.tiles.get(n) {
-                    if let Some(p) = t.parent() {
-                        if t.level > root.level {
-                            assert!(tiles.available(&p));
-                        }
-                    }
-                }
-                n += 1;
+        let doc: Value = serde_json::from_slice(&b.subtree).unwrap();
+        assert_eq!(doc["asset"]["version"], "1.1");
+        assert_eq!(doc["root"]["refine"], "REPLACE");
+        let mut nodes = Vec::new();
+        walk(&doc["root"], root, &mut nodes);
+        let (mut contents, mut children) = (Vec::new(), Vec::new());
+        for (t, node, is_subtree) in &nodes {
+            if node.get("content").is_none() {
+                continue;
+            }
+            let (c, r) = tiles.sphere(t);
+            assert_eq!(node["boundingVolume"]["sphere"], json!([c.x, c.y, c.z, r]), "{t:?}");
+            assert_eq!(node["geometricError"].as_f64().unwrap(), tiles.geometric_error(t));
+            assert!(tiles.available(t), "{t:?}");
+            if *is_subtree {
+                assert_eq!(t.level, root.level + SUBTREE_LEVELS);
+                children.push(*t);
+            } else {
+                contents.push(*t);
             }
         }
-        assert_eq!(st.children.count(), b.children.len());
+        contents.sort();
+        let mut want: Vec<TileCoord> = b.contents.iter().map(|c| c.0).collect();
+        want.sort();
+        assert_eq!(contents, want, "{root:?}");
+        children.sort();
+        let mut kids = b.children.clone();
+        kids.sort();
+        assert_eq!(children, kids);
         assert_eq!(tiles.child_subtrees(root), b.children);
-        // the header and both parts are 8-byte aligned
-        let jl = u64::from_le_bytes(b.subtree[8..16].try_into().unwrap());
-        assert_eq!(jl % 8, 0);
-        assert_eq!(b.subtree.len() % 8, 0);
+        // every node has a sphere and an error
+        assert!(nodes.iter().all(
+            |(_, n, _)| n["boundingVolume"]["sphere"].as_array().is_some_and(|a| a.len() == 4)
+                && n["geometricError"].is_number()
+        ));
     }
 }
 
@@ -338,45 +369,20 @@ fn tiles_are_the_same_bytes_on_any_thread_count() {
 }
 
 #[test]
-fn the_tileset_names_six_implicit_face_octrees() {
+fn the_tileset_names_the_six_faces_subtree_files() {
     let tiles = small_tiles(TileFrame::Sphere, TileOptions::default());
     let ts = tiles.tileset_json("r2/", json!({"terrain": "earthlike"}));
     assert_eq!(ts["asset"]["version"], "1.1");
     let faces = ts["root"]["children"].as_array().unwrap();
     assert_eq!(faces.len(), 6);
-    for f in faces {
-        let it = &f["implicitTiling"];
-        assert_eq!(it["subdivisionScheme"], "OCTREE");
-        assert_eq!(it["subtreeLevels"], 3);
-        assert_eq!(it["availableLevels"], 3);
-        assert!(f["content"]["uri"].as_str().unwrap().starts_with("r2/content/"));
-        assert_eq!(f["boundingVolume"]["box"].as_array().unwrap().len(), 12);
+    for (f, face) in faces.iter().zip(Face::ALL) {
+        assert_eq!(f["content"]["uri"], format!("r2/subtrees/{}/0/0/0/0.json", face.name()));
+        let (c, r) = tiles.sphere(&TileCoord::root(face));
+        assert_eq!(f["boundingVolume"]["sphere"], json!([c.x, c.y, c.z, r]));
     }
     assert_eq!(ts["extras"]["pmc"]["terrain"], "earthlike");
     assert_eq!(ts["extras"]["pmc"]["frame"], "sphere");
-    let props = &ts["schema"]["classes"]["tile"]["properties"];
-    assert_eq!(props["boundingSphere"]["semantic"], "TILE_BOUNDING_SPHERE");
-    assert_eq!(props["geometricError"]["semantic"], "TILE_GEOMETRIC_ERROR");
-}
-
-#[test]
-fn each_face_box_holds_its_tiles() {
-    for frame in [TileFrame::Sphere, TileFrame::Wgs84 { datum: 510.0 }] {
-        let tiles = small_tiles(frame, TileOptions::default());
-        for (root, b) in all_subtrees(&tiles) {
-            let bx = tiles.face_box(root.face);
-            let c = DVec3::new(bx[0], bx[1], bx[2]);
-            let axes = [3, 6, 9].map(|i| DVec3::new(bx[i], bx[i + 1], bx[i + 2]));
-            for (_, glb) in &b.contents {
-                for p in glb_positions(glb).1 {
-                    for a in axes {
-                        let along = (p - c).dot(a) / a.length_squared();
-                        assert!(along.abs() <= 1.0, "{frame:?} {root:?}: {along}");
-                    }
-                }
-            }
-        }
-    }
+    assert!(ts["geometricError"].as_f64().unwrap() >= 500.0);
 }
 
 fn folder_bytes(dir: &Path) -> BTreeMap<String, Vec<u8>> {

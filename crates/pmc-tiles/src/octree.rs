@@ -1,8 +1,8 @@
-//! The implicit octree of each cube face: tile coordinates, chunk keys, Morton order.
+//! The octree of each cube face: tile coordinates, chunk keys, Morton order.
 //!
 //! A face's chunks already form an octree that also covers depth (`ChunkKey::level`: a level-`L`
-//! chunk covers `2^L` level-0 chunks along `u`, `v` and depth). Implicit tiling counts levels
-//! the other way, from the root: implicit level `ℓ` holds the chunks of level
+//! chunk covers `2^L` level-0 chunks along `u`, `v` and depth). Tiles count levels the other
+//! way, from the root: tile level `ℓ` holds the chunks of level
 //! `L = top + v - ℓ`, with `x = i`, `y = j`, `z = k` (depth outward), where `top` is the
 //! layout's coarsest level and `v` the number of *virtual* levels above it. A layout whose
 //! coarsest level has more than one chunk per face side or along depth (`m` of them) needs
@@ -14,7 +14,7 @@ use pmc_geometry::{ChunkKey, Face, Layout};
 /// Levels per subtree file: a subtree holds `1 + 8 + 64` tiles and up to 512 child subtrees.
 pub const SUBTREE_LEVELS: u8 = 3;
 
-/// A tile of a face's implicit octree.
+/// A tile of a face's tile octree.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct TileCoord {
     /// The face whose octree holds the tile.
@@ -114,7 +114,7 @@ pub fn octree_tiles(levels: u8) -> u64 {
     ((1u64 << (3 * u32::from(levels))) - 1) / 7
 }
 
-/// How a layout's chunks sit in the faces' implicit octrees.
+/// How a layout's chunks sit in the faces' tile octrees.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tiling {
     layout: Layout,
@@ -150,13 +150,13 @@ impl Tiling {
         self.virtual_levels + self.top + 1
     }
 
-    /// The level of detail of implicit level `level` (`None` for a virtual level).
+    /// The level of detail of tile level `level` (`None` for a virtual level).
     pub fn chunk_level(&self, level: u8) -> Option<u8> {
         let l = (self.top + self.virtual_levels).checked_sub(level)?;
         (level >= self.virtual_levels).then_some(l)
     }
 
-    /// The implicit level of level of detail `lod`.
+    /// The tile level of level of detail `lod`.
     pub fn tile_level(&self, lod: u8) -> u8 {
         self.top + self.virtual_levels - lod
     }

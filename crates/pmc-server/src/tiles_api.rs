@@ -1,0 +1,297 @@
+//! OGC 3D Tiles 1.1 of the served planet, live (`docs/specs/tiles-v1.md`):
+//!
+//! - `GET /tiles/tileset.json`: the tileset of the planet as it is now (with a world, its
+//!   edits). Its subtree and content URLs carry the planet's edit revision, `r<N>/`, so a client
+//!   that fetches the tileset again after an edit asks for new URLs and no cache serves it the
+//!   old terrain.
+//! - `GET /tiles/r<N>/subtrees/FACE/LEVEL/X/Y/Z.json`: a subtree file (an external tileset of
+//!   three levels of tiles).
+//! - `GET /tiles/r<N>/content/FACE/LEVEL/X/Y/Z.glb`: a tile's glTF content.
+//!
+//! A subtree is built whole, its tiles meshed in parallel (`pmc_tiles::TileSet::build_subtree`),
+//! and kept with its contents in a cache bounded by bytes; requests for a subtree being built
+//! wait for that one build. At most as many builds run at once as the server has worker
+//! threads; a request that goes away before its build starts withdraws it. An old revision's
+//! URLs are answered from the planet as it is now: the revision names a version for caches,
+//! it is not kept.
+
+use crate::chunk_cache::ByteCache;
+use crate::request::ApiError;
+use crate::AppState;
+use axum::body::Bytes;
+use axum::extract::rejection::PathRejection;
+use axum::extract::{Path, State};
+use axum::http::{header, HeaderValue, StatusCode};
+use axum::response::{IntoResponse, Response};
+use pmc_geometry::Face;
+use pmc_tiles::{SubtreeBuild, TileCoord, TileFrame, TileOptions, TileSet};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, PoisonError};
+use tokio::sync::{watch, Semaphore};
+
+/// Where the served tiles are placed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TilesFrame {
+    /// WGS84 for a planet of the Earth's size, else its sphere.
+    #[default]
+    Auto,
+    /// On the WGS84 ellipsoid.
+    Wgs84,
+    /// On the planet's own sphere.
+    Sphere,
+}
+
+/// A built subtree: the planet's revision and the subtree's root.
+type Key = (u64, TileCoord);
+type Built = Result<Arc<SubtreeBuild>, Arc<str>>;
+
+/// The tiles of the served planet.
+pub(crate) struct ServedTiles {
+    frame: TilesFrame,
+    cache: Mutex<ByteCache<Key, Arc<SubtreeBuild>>>,
+    building: Mutex<HashMap<Key, watch::Receiver<Option<Built>>>>,
+    permits: Arc<Semaphore>,
+    /// The tileset of the latest revision asked for.
+    tileset: Mutex<Option<(u64, Arc<TileSet>)>>,
+}
+
+impl ServedTiles {
+    /// Tiles placed in `frame`, with `cache_bytes` of built subtrees and at most `builds` at once.
+    pub(crate) fn new(frame: TilesFrame, cache_bytes: u64, builds: usize) -> ServedTiles {
+        ServedTiles {
+            frame,
+            cache: Mutex::new(ByteCache::new(cache_bytes)),
+            building: Mutex::new(HashMap::new()),
+            permits: Arc::new(Semaphore::new(builds.max(1))),
+            tileset: Mutex::new(None),
+        }
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// The tileset of the served planet at its current revision (made once per revision).
+async fn tileset(state: &AppState) -> Result<(u64, Arc<TileSet>), ApiError> {
+    let tiles = state.tiles();
+    let id = Arc::new(state.config().terrain.clone());
+    let (planet, revision) = state.planet(id).await.map_err(ApiError::internal)?;
+    if let Some((r, t)) = lock(&tiles.tileset).as_ref() {
+        if *r == revision {
+            return Ok((*r, t.clone()));
+        }
+    }
+    let errors = state.lod_errors_of_default().await.map_err(ApiError::internal)?;
+    let datum = planet.datum_radius();
+    let frame = match tiles.frame {
+        TilesFrame::Auto => TileFrame::default_for(datum),
+        TilesFrame::Wgs84 => TileFrame::Wgs84 { datum },
+        TilesFrame::Sphere => TileFrame::Sphere,
+    };
+    let generator = format!("pmc {}", env!("CARGO_PKG_VERSION"));
+    let set = TileSet::new(planet, (*errors).clone(), frame, TileOptions::default(), &generator)
+        .map_err(|e| ApiError::not_found(format!("this planet has no 3D Tiles: {e}")))?;
+    let set = Arc::new(set);
+    *lock(&tiles.tileset) = Some((revision, set.clone()));
+    Ok((revision, set))
+}
+
+fn respond(bytes: Bytes, content_type: &'static str, cache: &'static str) -> Response {
+    let mut r = bytes.into_response();
+    let h = r.headers_mut();
+    h.insert(header::CONTENT_TYPE, HeaderValue::from_static(content_type));
+    h.insert(header::CACHE_CONTROL, HeaderValue::from_static(cache));
+    // Public, read-only data: a page of any origin may load it (a CesiumJS app elsewhere).
+    h.insert(header::ACCESS_CONTROL_ALLOW_ORIGIN, HeaderValue::from_static("*"));
+    r
+}
+
+/// `GET /tiles/tileset.json`.
+pub async fn tileset_json(State(state): State<AppState>) -> Result<Response, ApiError> {
+    let (revision, set) = tileset(&state).await?;
+    let edits = state.editing().map(|e| e.current().active);
+    let extras = pmc_tiles::planet_extras(set.planet(), edits);
+    let mut extras = extras;
+    extras["revision"] = serde_json::json!(revision);
+    let json = set.tileset_json(&format!("r{revision}/"), extras);
+    let body = serde_json::to_vec(&json).map_err(|e| ApiError::internal(e.to_string()))?;
+    Ok(respond(Bytes::from(body), "application/json", "no-cache"))
+}
+
+/// The parts of a tile path: revision, kind, face, level, x, y, and the last part `Z.EXT`.
+type TilePath = (String, String, String, String, String, String, String);
+
+/// The tile named by a path, checked against the tileset: 400 when malformed, 404 when not one
+/// of its tiles.
+fn parse(set: &TileSet, p: &TilePath, ext: &str) -> Result<(u64, TileCoord), ApiError> {
+    let (rev, _, face, level, x, y, last) = p;
+    let shown = format!("{face}/{level}/{x}/{y}/{last}");
+    let revision = rev
+        .strip_prefix('r')
+        .and_then(|r| r.parse::<u64>().ok())
+        .ok_or_else(|| ApiError::bad_request(format!("'{rev}' is not a revision (r followed by a number)")))?;
+    let z = last
+        .strip_suffix(ext)
+        .ok_or_else(|| ApiError::not_found(format!("{shown}: expected a name ending in {ext}")))?;
+    let face: Face = face.parse().map_err(ApiError::bad_request)?;
+    let num = |name: &str, s: &str| {
+        s.parse::<u32>()
+            .map_err(|_| ApiError::bad_request(format!("tile {name} must be a non-negative integer, got '{s}'")))
+    };
+    let level = num("level", level)?;
+    let t = TileCoord {
+        face,
+        level: u8::try_from(level).unwrap_or(u8::MAX),
+        x: num("x", x)?,
+        y: num("y", y)?,
+        z: num("z", z)?,
+    };
+    if level >= u32::from(set.available_levels()) || !set.tiling().exists(&t) {
+        return Err(ApiError::not_found(format!("{shown} is not a tile of this planet")));
+    }
+    Ok((revision, t))
+}
+
+/// The subtree rooted at `root`, from the cache, from a build under way, or built now.
+async fn subtree(
+    state: &AppState,
+    set: Arc<TileSet>,
+    revision: u64,
+    root: TileCoord,
+) -> Result<Arc<SubtreeBuild>, ApiError> {
+    let tiles = state.tiles();
+    let key = (revision, root);
+    if let Some(b) = lock(&tiles.cache).get(&key) {
+        return Ok(b.clone());
+    }
+    // Join a build under way, or start one.
+    let (mut rx, tx) = {
+        let mut building = lock(&tiles.building);
+        match building.get(&key) {
+            Some(rx) => (rx.clone(), None),
+            None => {
+                let (tx, rx) = watch::channel(None);
+                building.insert(key, rx.clone());
+                (rx, Some(tx))
+            }
+        }
+    };
+    if let Some(tx) = tx {
+        // This request builds it. Leaving while waiting for a permit withdraws the build.
+        struct Unlist<'a>(&'a ServedTiles, Key, bool);
+        impl Drop for Unlist<'_> {
+            fn drop(&mut self) {
+                if !self.2 {
+                    lock(&self.0.building).remove(&self.1);
+                }
+            }
+        }
+        let mut unlist = Unlist(tiles, key, false);
+        let permit = tiles
+            .permits
+            .clone()
+            .acquire_owned()
+            .await
+            .map_err(|_| ApiError::internal("the server is stopping"))?;
+        // From here the build finishes and is kept even if this request goes away.
+        let st = state.clone();
+        let task = tokio::task::spawn_blocking(move || {
+            let built: Built = set
+                .build_subtree(root)
+                .map(Arc::new)
+                .map_err(|e| Arc::from(e.to_string()));
+            let tiles = st.tiles();
+            if let Ok(b) = &built {
+                let size = b.subtree.len() + b.contents.iter().map(|(_, c)| c.len()).sum::<usize>();
+                lock(&tiles.cache).insert(key, b.clone(), size as u64);
+            }
+            lock(&tiles.building).remove(&key);
+            let _ = tx.send(Some(built.clone()));
+            drop(permit);
+            built
+        });
+        unlist.2 = true;
+        let built: Built = task
+            .await
+            .map_err(|e| Arc::from(format!("building the subtree failed: {e}")))
+            .and_then(|b| b);
+        return built.map_err(|e| ApiError::internal(e.to_string()));
+    }
+    loop {
+        if let Some(b) = rx.borrow_and_update().clone() {
+            return b.map_err(|e| ApiError::internal(e.to_string()));
+        }
+        if rx.changed().await.is_err() {
+            // The builder went away before building: ask again.
+            return Box::pin(subtree(state, set, revision, root)).await;
+        }
+    }
+}
+
+/// `GET /tiles/{rev}/subtrees/{face}/{level}/{x}/{y}/{z}.json` and
+/// `GET /tiles/{rev}/content/{face}/{level}/{x}/{y}/{z}.glb`.
+pub async fn tile_file(
+    State(state): State<AppState>,
+    path: Result<Path<TilePath>, PathRejection>,
+) -> Result<Response, ApiError> {
+    let Path(p) = path.map_err(|e| ApiError::bad_request(format!("malformed tile path: {e}")))?;
+    match p.1.as_str() {
+        "subtrees" => subtree_file(&state, p).await,
+        "content" => content_file(&state, p).await,
+        other => Err(ApiError::not_found(format!(
+            "/tiles/{}/{other}/...: tiles have `subtrees` and `content`",
+            p.0
+        ))),
+    }
+}
+
+async fn subtree_file(state: &AppState, p: TilePath) -> Result<Response, ApiError> {
+    let (current, set) = tileset(state).await?;
+    let (revision, t) = parse(&set, &p, ".json")?;
+    check_revision(revision, current)?;
+    if t.subtree_root() != t {
+        return Err(ApiError::not_found(format!(
+            "{}/{} is not the root of a subtree (subtrees start every {} levels)",
+            t.face,
+            t.path(),
+            pmc_tiles::SUBTREE_LEVELS
+        )));
+    }
+    let b = subtree(state, set, current, t).await?;
+    Ok(respond(
+        Bytes::from(b.subtree.clone()),
+        "application/json",
+        "public, max-age=3600",
+    ))
+}
+
+async fn content_file(state: &AppState, p: TilePath) -> Result<Response, ApiError> {
+    let (current, set) = tileset(state).await?;
+    let (revision, t) = parse(&set, &p, ".glb")?;
+    check_revision(revision, current)?;
+    let b = subtree(state, set, current, t.subtree_root()).await?;
+    match b.contents.iter().find(|(c, _)| *c == t) {
+        Some((_, glb)) => Ok(respond(
+            Bytes::from(glb.clone()),
+            "model/gltf-binary",
+            "public, max-age=3600",
+        )),
+        None => Err(ApiError::not_found(format!(
+            "tile {}/{} has no content (its subtree says so)",
+            t.face,
+            t.path()
+        ))),
+    }
+}
+
+/// A revision later than the planet's is not one it had.
+fn check_revision(asked: u64, current: u64) -> Result<(), ApiError> {
+    if asked > current {
+        return Err(ApiError {
+            status: StatusCode::NOT_FOUND,
+            message: format!("revision {asked} is later than the planet's ({current})"),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,28 @@
+import { chromium } from 'playwright-core';
+import { spawn } from 'node:child_process';
+import { chromiumArgs } from './harness.mjs';
+const bin = process.env.PMC_BIN;
+const srv = spawn(bin, ['serve', '--port', '0', '--preset', process.env.PRESET ?? 'earth', '--cesium-js', '/work/main/examples/cesium/node_modules/cesium/Build/Cesium'], { stdio: ['ignore', 'pipe', 'inherit'] });
+const url = await new Promise((res) => srv.stdout.on('data', (d) => { const m = /PMC viewer: (\S+)/.exec(String(d)); if (m) res(m[1]); }));
+const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', headless: true, args: chromiumArgs('llvmpipe') });
+const page = await browser.newPage({ viewport: { width: 1024, height: 640 } });
+page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') console.log('console', m.type(), m.text()); });
+page.on('pageerror', (e) => console.log('pageerror', e.message));
+page.on('requestfinished', async (r) => { const res = await r.response(); if (/tiles\//.test(r.url()) || (res && res.status() >= 400)) console.log('REQ', res?.status(), r.url()); }); page.on('requestfailed', (r) => console.log('FAILED', r.url()));
+const q = process.env.Q ?? '';
+const t0 = Date.now();
+await page.goto(`${url}cesium/?${q}`);
+await page.waitForFunction(() => window.__pmcCesium, null, { timeout: 60000 });
+if (process.env.COLORIZE) await page.evaluate(() => { window.__pmcCesium.tileset.debugColorizeTiles = true; });
+await page.evaluate(() => window.__pmcCesium.loaded());
+console.log('loaded in', (Date.now() - t0) / 1000, 's', await page.evaluate(() => { const s = window.__pmcCesium.tileset.statistics; return [s.numberOfTilesWithContentReady, s.numberOfTilesTotal, s.visited]; }));
+console.log(JSON.stringify(await page.evaluate(() => window.__pmcCesium.tileset._selectedTiles.map((t) => [t.content?.url?.replace(/.*content\//, ''), Math.round(t.geometricError), Math.round(t.boundingSphere.radius), Math.round(t._distanceToCamera), t.content?.trianglesLength]).sort((a, b) => a[3] - b[3]).slice(0, 12))));
+console.log("X", JSON.stringify(await page.evaluate(() => {
+  const ts = window.__pmcCesium.tileset;
+  const t = ts._selectedTiles.find((t) => t.implicitCoordinates?.level === 5);
+  const desc = (t) => ({ lvl: t.implicitCoordinates?.level, xyz: [t.implicitCoordinates?.x, t.implicitCoordinates?.y, t.implicitCoordinates?.z], hasContent: t.hasRenderableContent, ready: t.contentReady, unloaded: t.contentUnloaded, failed: t.contentFailed, vis: t._visibilityPlaneMask, sse: t._screenSpaceError, implicitPlaceholder: t.hasImplicitContent, n: t.children.length, kids: t.children.map((c) => [c.implicitCoordinates?.level, c.hasImplicitContent, c.children.length, c.children.map((g) => [g.implicitCoordinates?.level, g.implicitCoordinates?.x, g.implicitCoordinates?.y, g.implicitCoordinates?.z, g.hasRenderableContent, g.contentReady, g.contentUnloaded, g._visibilityPlaneMask])]) });
+  return t ? desc(t) : 'none';
+})));
+await page.screenshot({ path: process.env.OUT ?? '/tmp/cz/try/shot.png' });
+await browser.close();
+srv.kill();
