@@ -29,9 +29,12 @@ if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 fi
 
-step "install the viewer's packages, Chromium for its end-to-end tests, and the real Earth's data"
+step "install the viewer's packages, CesiumJS, Chromium for its end-to-end tests, and the real Earth's data"
 if [ ! -d viewer/node_modules ]; then
   (cd viewer && npm ci --no-audit --no-fund --loglevel=error)
+fi
+if [ ! -d examples/cesium/node_modules/cesium ]; then
+  (cd examples/cesium && npm ci --no-audit --no-fund --loglevel=error)
 fi
 # Debian packages: chromium (the end-to-end tests), Mesa's EGL and software driver (llvmpipe, the
 # WebGL of most steps: viewer/e2e/harness.mjs), ferret-datasets (NOAA's ETOPO5 and ETOPO20 relief,
@@ -105,6 +108,11 @@ step "export planets and validate them"
 "$PMC" generate --quiet --preset moon --seed 3 --n-c 4 -o "$OUT/moon.glb"
 "$PMC" generate --quiet --preset mars --seed 5 --n-c 4 -o "$OUT/mars.glb"
 node tools/gltf-validate/validate.mjs "$OUT/sphere.glb" "$OUT/earthlike.glb" "$OUT/moon.glb" "$OUT/mars.glb"
+# 3D Tiles: every tile content of a small planet's bake, by the same validator
+rm -rf "$OUT/tiles"
+"$PMC" tiles bake --quiet --preset moon --seed 3 --n-c 8 --n-t 16 -o "$OUT/tiles"
+find "$OUT/tiles/content" -name '*.glb' -print0 | xargs -0 node tools/gltf-validate/validate.mjs > "$OUT/tiles-validate.log"
+echo "gltf-validator: $(grep -c ': ok 0 errors' "$OUT/tiles-validate.log") tile contents valid"
 
 # The sphere preset's radius: d_b + T/2 + 0.37 l_d with T = l_d n_t d_c.
 R=$(python3 -c "print(1744 + 4*16*2/2 + 0.37*4)")
@@ -117,8 +125,9 @@ step "viewer: end-to-end tests in headless Chromium against pmc serve"
 
 step "all checks passed"
 # One closing line: the Rust suite's totals plus the external checks above (the validator run
-# and the two trimesh checks; any failure there has already stopped the script).
-EXTERNAL_CHECKS=3
+# and the two trimesh checks, the tiles' validator run; any failure there has already stopped
+# the script).
+EXTERNAL_CHECKS=4
 VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
 awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log

@@ -20,9 +20,9 @@
 //                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
-//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9, and step
-//                   15 run in browsers of their own beside the others; the soak, step 18, runs
-//                   last and alone)
+//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9, step 15
+//                   and CesiumJS's, step 19, run in browsers of their own beside the others; the
+//                   soak, step 18, runs last and alone)
 //   PMC_E2E_GL      llvmpipe or swiftshader: the software renderer of WebGL (by default Mesa's
 //                   llvmpipe where installed; the flights always draw with SwiftShader)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
@@ -39,6 +39,7 @@ import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { openBrowser } from './browser.mjs';
 import { CHROMIUM, FLIGHTS_GL, GALLERY, GL, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, selected, short, started, step } from './harness.mjs';
+import * as cesiumTiles from './scenarios/cesiumTiles.mjs';
 import * as closeup from './scenarios/closeup.mjs';
 import * as editing from './scenarios/editing.mjs';
 import * as elevationModel from './scenarios/elevationModel.mjs';
@@ -74,11 +75,12 @@ const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndMode
 const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays, levelSwitch];
 /**
  * The flights over true-scale planets (the earth preset, an elevation model) and the default
- * planet's levels of detail, then the sea by the data, each with servers of their own: in a
+ * planet's levels of detail, the sea by the data, then the planet's 3D Tiles in CesiumJS, each
+ * with servers of their own: in a
  * browser of their own beside the others (PMC_E2E_LANES, by default 2), the two lanes of about the
  * same length.
  */
-const SECOND_LANE = [lodEarth, elevationModel, lodDefault, seaByData];
+const SECOND_LANE = [lodEarth, elevationModel, lodDefault, seaByData, cesiumTiles];
 /** The steps whose pictures with back faces flagged are drawn by FLIGHTS_GL (harness.mjs). */
 const FLIGHTS = new Set([lodEarth, elevationModel, lodDefault]);
 /** Then, alone on the machine (it compares the times of its views): the soak. */

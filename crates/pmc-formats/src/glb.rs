@@ -56,9 +56,11 @@ pub fn write_glb<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -> R
 /// laid out as in version 1 of the GLB layout (`docs/specs/glb-v1.md`); `extras` becomes the
 /// asset's extras. Returns the bytes written.
 ///
+/// A mesh with no triangle gives a node with no mesh (a tile whose chunk the bounds could not
+/// tell empty, and that meshed to nothing).
+///
 /// # Errors
-/// [`ExportError::InvalidMesh`] for an inconsistent mesh or one with no triangle, and the
-/// writer's I/O errors.
+/// [`ExportError::InvalidMesh`] for an inconsistent mesh, and the writer's I/O errors.
 pub fn write_tile_glb<W: Write>(
     mesh: &ChunkMesh,
     name: &str,
@@ -68,13 +70,6 @@ pub fn write_tile_glb<W: Write>(
 ) -> Result<u64, ExportError> {
     let meshes = std::slice::from_ref(mesh);
     let checked = check_meshes(meshes)?;
-    let Some(c) = checked.first() else {
-        return Err(ExportError::InvalidMesh {
-            index: 0,
-            name: name.to_string(),
-            reason: "a tile needs at least one triangle".to_string(),
-        });
-    };
     let mut b = Builder {
         root: gj::Root::default(),
         blobs: Vec::new(),
@@ -86,8 +81,17 @@ pub fn write_tile_glb<W: Write>(
         generator: Some(generator.to_string()),
         ..Default::default()
     };
-    let terrain = b.root.push(material("terrain", [1.0; 4], 0.9, false));
-    let node = b.chunk_node(c, name.to_string(), terrain);
+    let node = match checked.first() {
+        Some(c) => {
+            let terrain = b.root.push(material("terrain", [1.0; 4], 0.9, false));
+            b.chunk_node(c, name.to_string(), terrain)
+        }
+        // no triangle: a node with no mesh
+        None => b.root.push(gj::Node {
+            name: Some(name.to_string()),
+            ..Default::default()
+        }),
+    };
     b.finish("tile", node, extras, out)
 }
 

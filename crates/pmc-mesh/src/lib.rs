@@ -18,7 +18,7 @@ pub mod topology;
 pub mod transition;
 
 pub use chunk_mesh::ChunkMesh;
-pub use mesher::{is_solid, voxel_gradient, Mesher};
+pub use mesher::{has_sign_change, is_solid, voxel_gradient, Mesher};
 pub use region::CubeBox;
 pub use shell::close_shell;
 pub use topology::{ManifoldReport, WeldedMesh};

@@ -285,7 +285,9 @@ pub(crate) fn cube_case(densities: &[f32], base: usize, corners: &[usize; 8]) ->
 }
 
 /// Whether the chunk's own (unpadded) samples hold both solid and air.
-fn has_sign_change(grid: &ChunkGrid, d: &[f32]) -> bool {
+/// Whether the chunk's own voxels (not its padding) of `d`, the padded samples of `grid`, are
+/// not all of one side: the mesher makes triangles exactly then.
+pub fn has_sign_change(grid: &ChunkGrid, d: &[f32]) -> bool {
     let n = grid.tiles;
     let first = is_solid(d[grid.index(1, 1, 1)]);
     for c in 1..=n + 1 {

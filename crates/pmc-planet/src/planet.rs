@@ -390,6 +390,26 @@ impl Planet {
         self.uniform_by_bound(&ChunkGrid::new(&self.layout, *key))
     }
 
+    /// Whether chunk `key` meshes to nothing: told by the bounds
+    /// ([`Planet::holds_no_surface_by_bound`]), or else by sampling its batch (through the base
+    /// cache when there is one, which the chunk's meshing then reuses) and finding every voxel
+    /// of one side. Exact, at the cost of sampling the chunks the bounds cannot tell.
+    pub fn chunk_is_empty(&self, key: &ChunkKey, scratch: &mut ChunkScratch) -> bool {
+        if self.holds_no_surface_by_bound(key) {
+            return true;
+        }
+        if self.heightfield.is_some() {
+            return false;
+        }
+        let grid = self.grid_after(*key, scratch.grid.take());
+        scratch.densities.resize(grid.sample_count(), 0.0);
+        self.sample(*key, &grid, &mut scratch.densities, None);
+        close_shell(&grid, self.layout.depth_tiles(), &mut scratch.densities);
+        let empty = !pmc_mesh::has_sign_change(&grid, &scratch.densities);
+        scratch.grid = Some((self.layout, grid));
+        empty
+    }
+
     /// Whether the chunk of `grid` holds no surface by the density's own bound: every sample of
     /// its batch has one sign ([`Density::uniform_sign`]), and the shell's closure forces none of
     /// its layers to the other (layers at depth index `<= 0` are made solid, `>= depth` air).

@@ -8,12 +8,12 @@
 //!   three levels of tiles).
 //! - `GET /tiles/r<N>/content/FACE/LEVEL/X/Y/Z.glb`: a tile's glTF content.
 //!
-//! A subtree is built whole, its tiles meshed in parallel (`pmc_tiles::TileSet::build_subtree`),
-//! and kept with its contents in a cache bounded by bytes; requests for a subtree being built
-//! wait for that one build. At most as many builds run at once as the server has worker
-//! threads; a request that goes away before its build starts withdraws it. An old revision's
-//! URLs are answered from the planet as it is now: the revision names a version for caches,
-//! it is not kept.
+//! A subtree file is made from the tiles' availability alone (`pmc_tiles::TileSet::subtree_file`:
+//! nothing meshed), a content when a client asks for it (`pmc_tiles::TileSet::content`); both are
+//! kept in a cache bounded by bytes, and requests for one being made wait for that one. At most
+//! as many are made at once as the server has worker threads; a request that goes away before
+//! its work starts withdraws it. An old revision's URLs are answered from the planet as it is
+//! now: the revision names a version for caches, it is not kept.
 
 use crate::chunk_cache::ByteCache;
 use crate::request::ApiError;
@@ -24,7 +24,7 @@ use axum::extract::{Path, State};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use pmc_geometry::Face;
-use pmc_tiles::{SubtreeBuild, TileCoord, TileFrame, TileOptions, TileSet};
+use pmc_tiles::{TileCoord, TileFrame, TileOptions, TileSet};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 use tokio::sync::{watch, Semaphore};
@@ -41,14 +41,15 @@ pub enum TilesFrame {
     Sphere,
 }
 
-/// A built subtree: the planet's revision and the subtree's root.
-type Key = (u64, TileCoord);
-type Built = Result<Arc<SubtreeBuild>, Arc<str>>;
+/// A file made: the planet's revision, whether it is a content (else a subtree file), the tile.
+type Key = (u64, bool, TileCoord);
+/// The file's bytes, or `None` for a tile with no content.
+type Built = Result<Option<Bytes>, Arc<str>>;
 
 /// The tiles of the served planet.
 pub(crate) struct ServedTiles {
     frame: TilesFrame,
-    cache: Mutex<ByteCache<Key, Arc<SubtreeBuild>>>,
+    cache: Mutex<ByteCache<Key, Option<Bytes>>>,
     building: Mutex<HashMap<Key, watch::Receiver<Option<Built>>>>,
     permits: Arc<Semaphore>,
     /// The tileset of the latest revision asked for.
@@ -56,7 +57,7 @@ pub(crate) struct ServedTiles {
 }
 
 impl ServedTiles {
-    /// Tiles placed in `frame`, with `cache_bytes` of built subtrees and at most `builds` at once.
+    /// Tiles placed in `frame`, with `cache_bytes` of files made and at most `builds` made at once.
     pub(crate) fn new(frame: TilesFrame, cache_bytes: u64, builds: usize) -> ServedTiles {
         ServedTiles {
             frame,
@@ -153,19 +154,21 @@ fn parse(set: &TileSet, p: &TilePath, ext: &str) -> Result<(u64, TileCoord), Api
     Ok((revision, t))
 }
 
-/// The subtree rooted at `root`, from the cache, from a build under way, or built now.
-async fn subtree(
+/// The subtree file rooted at `t` (`content` false) or the content of tile `t`, from the cache,
+/// from the one being made, or made now.
+async fn made(
     state: &AppState,
     set: Arc<TileSet>,
     revision: u64,
-    root: TileCoord,
-) -> Result<Arc<SubtreeBuild>, ApiError> {
+    content: bool,
+    t: TileCoord,
+) -> Result<Option<Bytes>, ApiError> {
     let tiles = state.tiles();
-    let key = (revision, root);
+    let key = (revision, content, t);
     if let Some(b) = lock(&tiles.cache).get(&key) {
         return Ok(b.clone());
     }
-    // Join a build under way, or start one.
+    // Join the work under way, or start it.
     let (mut rx, tx) = {
         let mut building = lock(&tiles.building);
         match building.get(&key) {
@@ -178,7 +181,7 @@ async fn subtree(
         }
     };
     if let Some(tx) = tx {
-        // This request builds it. Leaving while waiting for a permit withdraws the build.
+        // This request does the work. Leaving while waiting for a permit withdraws it.
         struct Unlist<'a>(&'a ServedTiles, Key, bool);
         impl Drop for Unlist<'_> {
             fn drop(&mut self) {
@@ -194,16 +197,18 @@ async fn subtree(
             .acquire_owned()
             .await
             .map_err(|_| ApiError::internal("the server is stopping"))?;
-        // From here the build finishes and is kept even if this request goes away.
+        // From here the work finishes and is kept even if this request goes away.
         let st = state.clone();
         let task = tokio::task::spawn_blocking(move || {
-            let built: Built = set
-                .build_subtree(root)
-                .map(Arc::new)
-                .map_err(|e| Arc::from(e.to_string()));
+            let made = if content {
+                set.content(&t).map(|c| c.map(Bytes::from))
+            } else {
+                set.subtree_file(t).map(|b| Some(Bytes::from(b.subtree)))
+            };
+            let built: Built = made.map_err(|e| Arc::from(e.to_string()));
             let tiles = st.tiles();
             if let Ok(b) = &built {
-                let size = b.subtree.len() + b.contents.iter().map(|(_, c)| c.len()).sum::<usize>();
+                let size = 64 + b.as_ref().map_or(0, |b| b.len());
                 lock(&tiles.cache).insert(key, b.clone(), size as u64);
             }
             lock(&tiles.building).remove(&key);
@@ -214,7 +219,7 @@ async fn subtree(
         unlist.2 = true;
         let built: Built = task
             .await
-            .map_err(|e| Arc::from(format!("building the subtree failed: {e}")))
+            .map_err(|e| Arc::from(format!("making the tile failed: {e}")))
             .and_then(|b| b);
         return built.map_err(|e| ApiError::internal(e.to_string()));
     }
@@ -223,8 +228,8 @@ async fn subtree(
             return b.map_err(|e| ApiError::internal(e.to_string()));
         }
         if rx.changed().await.is_err() {
-            // The builder went away before building: ask again.
-            return Box::pin(subtree(state, set, revision, root)).await;
+            // The one doing it went away before starting: ask again.
+            return Box::pin(made(state, set, revision, content, t)).await;
         }
     }
 }
@@ -258,27 +263,19 @@ async fn subtree_file(state: &AppState, p: TilePath) -> Result<Response, ApiErro
             pmc_tiles::SUBTREE_LEVELS
         )));
     }
-    let b = subtree(state, set, current, t).await?;
-    Ok(respond(
-        Bytes::from(b.subtree.clone()),
-        "application/json",
-        "public, max-age=3600",
-    ))
+    let b = made(state, set, current, false, t).await?;
+    let b = b.ok_or_else(|| ApiError::internal("a subtree file is always made"))?;
+    Ok(respond(b, "application/json", "public, max-age=3600"))
 }
 
 async fn content_file(state: &AppState, p: TilePath) -> Result<Response, ApiError> {
     let (current, set) = tileset(state).await?;
     let (revision, t) = parse(&set, &p, ".glb")?;
     check_revision(revision, current)?;
-    let b = subtree(state, set, current, t.subtree_root()).await?;
-    match b.contents.iter().find(|(c, _)| *c == t) {
-        Some((_, glb)) => Ok(respond(
-            Bytes::from(glb.clone()),
-            "model/gltf-binary",
-            "public, max-age=3600",
-        )),
+    match made(state, set, current, true, t).await? {
+        Some(glb) => Ok(respond(glb, "model/gltf-binary", "public, max-age=3600")),
         None => Err(ApiError::not_found(format!(
-            "tile {}/{} has no content (its subtree says so)",
+            "tile {}/{} has no content (its subtree file says so)",
             t.face,
             t.path()
         ))),

@@ -147,6 +147,77 @@ pub fn planet_extras(planet: &Planet, edits: Option<usize>) -> Value {
     v
 }
 
+/// The material id of a cap's vertices in a tile (`docs/specs/tiles-v1.md`): a client can tell
+/// the caps (seen only through a crack between levels) from the surface.
+pub const CAP_MATERIAL: u8 = 255;
+
+/// How far a tile's caps are moved out from its chunk's centre, as a fraction of their distance
+/// to it: a ten-thousandth (3 mm on a 38 m chunk, 3 m on a 40 km one), far beyond the `f32`
+/// rounding of a client drawing each tile relative to its own centre (about 1e-7 of the
+/// distance to the eye), far below a pixel.
+pub const CAP_OFFSET: f64 = 1e-4;
+
+/// Gives a closed chunk's caps vertices of their own, copies of the surface's border vertices
+/// with material [`CAP_MATERIAL`], moved out from `centre` (relative to the mesh's origin) by
+/// [`CAP_OFFSET`] of their distance to it, and joins each border edge of the surface to its cap
+/// by a *flange* (two triangles): the tile stays closed, and its caps now lie a hair past the
+/// chunk's sides, so that two tiles meeting there overlap by that hair instead of touching. A
+/// client that draws them with `f32` rounding then leaves no pinhole along their seam: a pixel's
+/// ray that slips between the two surfaces meets a flange. The surface is the triangles of the
+/// mesh's cubes; the caps are the triangles after them.
+fn separate_caps(mesh: &mut ChunkMesh, centre: DVec3) {
+    let surface = 3 * mesh.cube_runs.last().map_or(0, |r| r[1] as usize);
+    if surface == mesh.indices.len() {
+        return;
+    }
+    // The caps' edges, before their vertices are copied.
+    let mut cap_edges: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    for t in mesh.indices[surface..].chunks_exact(3) {
+        for e in 0..3 {
+            cap_edges.insert((t[e], t[(e + 1) % 3]));
+        }
+    }
+    let mut copy: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    for n in surface..mesh.indices.len() {
+        let v = mesh.indices[n];
+        let c = *copy.entry(v).or_insert_with(|| {
+            let i = v as usize;
+            let m = &mut *mesh;
+            let low = m.positions_low.get(i).copied().unwrap_or([0.0; 3]);
+            let p = DVec3::from(m.positions[i].map(f64::from)) + DVec3::from(low.map(f64::from));
+            let moved = centre + (p - centre) * (1.0 + CAP_OFFSET);
+            let high = moved.as_vec3();
+            m.positions.push(high.to_array());
+            if !m.positions_low.is_empty() {
+                m.positions_low.push((moved - high.as_dvec3()).as_vec3().to_array());
+            }
+            m.normals.push(m.normals[i]);
+            m.edge_keys.push(m.edge_keys[i]);
+            m.heights.push(m.heights[i]);
+            m.water_depths.push(m.water_depths[i]);
+            m.colors.push(m.colors[i]);
+            m.materials.push(CAP_MATERIAL);
+            if !m.vertex_edges.is_empty() {
+                m.vertex_edges.push(m.vertex_edges[i]);
+            }
+            (m.positions.len() - 1) as u32
+        });
+        mesh.indices[n] = c;
+    }
+    // Flanges: a surface edge a -> b whose cap runs b -> a becomes a quad a, b, b', a'.
+    let mut flanges = Vec::new();
+    for t in mesh.indices[..surface].chunks_exact(3) {
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            if cap_edges.contains(&(b, a)) {
+                let (a2, b2) = (copy[&a], copy[&b]);
+                flanges.extend_from_slice(&[b, a, a2, b, a2, b2]);
+            }
+        }
+    }
+    mesh.indices.extend_from_slice(&flanges);
+}
+
 /// The glTF coordinates of an ECEF vector: 3D Tiles turns glTF's Y-up into Z-up by
 /// `(x, y, z) -> (x, -z, y)`, so glTF holds `(X, Z, -Y)`.
 fn gltf_axes(e: DVec3) -> DVec3 {
@@ -247,12 +318,13 @@ impl TileSet {
     }
 
     /// The tile's bounding sphere in ECEF metres: it holds every vertex of the tile's content
-    /// and of its descendants' (REPLACE refinement), as stored: grown by a millionth for the
-    /// `f32` rounding of positions relative to its centre (at most `√3 · 2^-24` of the radius).
+    /// and of its descendants' (REPLACE refinement), as stored: grown by twice [`CAP_OFFSET`]
+    /// for the caps moved out from the chunk's centre, and for the `f32` rounding of positions
+    /// relative to its centre (at most `√3 · 2^-24` of the radius).
     pub fn sphere(&self, t: &TileCoord) -> (DVec3, f64) {
         let (c, r) = self.planet_sphere(t);
-        let (c, r) = self.frame.ball(c, r);
-        (c, r * (1.0 + 1e-6))
+        let (c, r) = self.frame.ball(c, r * (1.0 + CAP_OFFSET));
+        (c, r * (1.0 + CAP_OFFSET + 1e-6))
     }
 
     /// The tile's geometric error, metres: its level's measured error, stretched by the frame;
@@ -269,14 +341,12 @@ impl TileSet {
         }
     }
 
-    /// Whether the tile is in the tileset, its parent being in it: it exists, is within the
-    /// levels asked for and meets the region, and its chunk is not known to hold no surface
-    /// (`Planet::holds_no_surface_by_bound`: outside the radial bounds, or every sample of one
-    /// sign). So the tree follows the surface: air and rock end their branches, and a client
-    /// never walks a subtree with nothing to draw. A feature smaller than a level's voxels
-    /// inside a chunk whose every sample is of one sign (a small cave deep in rock) is not
-    /// reached through that chunk.
-    pub fn available(&self, t: &TileCoord) -> bool {
+    /// Whether the tile may be in the tileset, by what costs nothing to tell: it exists, is within
+    /// the levels asked for and meets the region, and its chunk lies within the planet's radial
+    /// bounds ([`pmc_planet::Planet::may_hold_surface`]). A subtree file lists each child subtree
+    /// that may be there; the child's own file says whether its root is
+    /// ([`TileSet::available`]).
+    pub fn candidate(&self, t: &TileCoord) -> bool {
         if t.level >= self.available_levels() || !self.tiling.exists(t) {
             return false;
         }
@@ -286,10 +356,23 @@ impl TileSet {
                 return false;
             }
         }
-        match self.tiling.key(t) {
-            Some(key) => !self.planet.holds_no_surface_by_bound(&key),
-            None => true,
-        }
+        self.tiling.key(t).is_none_or(|key| self.planet.may_hold_surface(&key))
+    }
+
+    /// Whether the tile is in the tileset, its parent being in it: a [`TileSet::candidate`] whose
+    /// chunk meshes to something (`Planet::chunk_is_empty`: told by the density's bounds where
+    /// they can, else by sampling the chunk). So the tree follows the surface: air and rock end
+    /// their branches, and a client never walks a subtree with nothing to draw. A feature
+    /// smaller than a level's voxels inside a chunk whose every sample is of one sign (a small
+    /// cave deep in rock) is not reached through that chunk.
+    pub fn available(&self, t: &TileCoord) -> bool {
+        self.candidate(t)
+            && self.tiling.key(t).is_none_or(|key| {
+                SCRATCH.with(|s| match s.try_borrow_mut() {
+                    Ok(mut s) => !self.planet.chunk_is_empty(&key, &mut s),
+                    Err(_) => !self.planet.chunk_is_empty(&key, &mut ChunkScratch::default()),
+                })
+            })
     }
 
     /// The chunk of a tile closed and shaded, or `None` when it has no surface or no chunk.
@@ -306,20 +389,27 @@ impl TileSet {
         })
     }
 
-    /// The tile's content, a binary glTF (see `docs/specs/tiles-v1.md`), or `None` when its
-    /// chunk has no surface. Positions are `f32` relative to the tile's sphere's centre in glTF
-    /// axes, the centre the node's `f64` translation.
+    /// Whether an available tile has content: it is a chunk's (not virtual) at or below the
+    /// tileset's least level with content. Told without meshing, so a subtree file names its
+    /// contents before they are made.
+    pub fn has_content(&self, t: &TileCoord) -> bool {
+        t.level >= self.options.min_level && self.tiling.key(t).is_some()
+    }
+
+    /// The tile's content, a binary glTF (see `docs/specs/tiles-v1.md`): every available tile of
+    /// a chunk at or below the tileset's least level has one ([`TileSet::has_content`]). `None`
+    /// for the others. Positions are `f32` relative to the tile's sphere's centre in glTF axes, the
+    /// centre the node's `f64` translation.
     pub fn content(&self, t: &TileCoord) -> Result<Option<Vec<u8>>, TilesError> {
-        if t.level < self.options.min_level {
-            return Ok(None);
-        }
-        let Some(key) = self.tiling.key(t) else {
+        let Some(key) = self.tiling.key(t).filter(|_| self.has_content(t)) else {
             return Ok(None);
         };
-        let mut mesh = self.closed_mesh(key);
-        if mesh.indices.is_empty() {
+        if !self.available(t) {
             return Ok(None);
         }
+        let mut mesh = self.closed_mesh(key);
+        let origin = mesh.origin;
+        separate_caps(&mut mesh, self.planet_sphere(t).0 - origin);
         let (centre, _) = self.sphere(t);
         for i in 0..mesh.vertex_count() {
             let w = mesh.world_position_full(i);
@@ -347,6 +437,17 @@ impl TileSet {
     /// deepest tiles, one tile per available child subtree whose content is that subtree's file.
     /// The same bytes every time, on any thread count.
     pub fn build_subtree(&self, root: TileCoord) -> Result<SubtreeBuild, TilesError> {
+        self.build(root, true)
+    }
+
+    /// The subtree file rooted at `root` alone, as [`TileSet::build_subtree`] writes it, without
+    /// meshing its tiles: what a server answers before a client asks for the contents one by one
+    /// ([`TileSet::content`]).
+    pub fn subtree_file(&self, root: TileCoord) -> Result<SubtreeBuild, TilesError> {
+        self.build(root, false)
+    }
+
+    fn build(&self, root: TileCoord, with_contents: bool) -> Result<SubtreeBuild, TilesError> {
         if !root.level.is_multiple_of(SUBTREE_LEVELS) {
             return Err(TilesError::Invalid(format!(
                 "tile {}/{} is not the root of a subtree",
@@ -356,16 +457,20 @@ impl TileSet {
         }
         let count = octree_tiles(SUBTREE_LEVELS) as usize;
         let (coords, tiles) = self.availability(root);
-        let contents: Vec<Option<Vec<u8>>> = (0..count)
-            .into_par_iter()
-            .map(|n| {
-                if tiles.get(n) {
-                    self.content(&coords[n])
-                } else {
-                    Ok(None)
-                }
-            })
-            .collect::<Result<_, _>>()?;
+        let contents: Vec<Option<Vec<u8>>> = if with_contents {
+            (0..count)
+                .into_par_iter()
+                .map(|n| {
+                    if tiles.get(n) {
+                        self.content(&coords[n])
+                    } else {
+                        Ok(None)
+                    }
+                })
+                .collect::<Result<_, _>>()?
+        } else {
+            vec![None; count]
+        };
         let (_, child_roots) = self.children_of(root, &tiles);
         // URLs are relative to the subtree file, `subtrees/FACE/LEVEL/X/Y/Z.json`.
         let up = "../../../../../";
@@ -383,7 +488,7 @@ impl TileSet {
             }
             let t = coords[n];
             let mut v = node(&t);
-            if contents[n].is_some() {
+            if self.has_content(&t) {
                 v["content"] = json!({"uri": format!("{up}content/{}/{}.glb", t.face.name(), t.path())});
             }
             let mut children = Vec::new();
@@ -438,35 +543,52 @@ impl TileSet {
             }
         }
         let mut tiles = Bits::zeros(count);
-        for (n, t) in coords.iter().enumerate() {
-            let parent_ok = match t.level - root.level {
-                0 => true,
-                d => {
-                    let p = t.parent().expect("below the root");
-                    let pd = u32::from(d - 1);
-                    let (px, py, pz) = (p.x - (root.x << pd), p.y - (root.y << pd), p.z - (root.z << pd));
-                    tiles.get(octree_tiles(d - 1) as usize + octree::morton3(px, py, pz) as usize)
+        // Level by level (a tile needs its parent), the tiles of a level tested in parallel.
+        for d in 0..SUBTREE_LEVELS {
+            let first = octree_tiles(d) as usize;
+            let level = &coords[first..first + (1usize << (3 * u32::from(d)))];
+            let ok: Vec<bool> = level
+                .par_iter()
+                .map(|t| {
+                    let parent_ok = match d {
+                        0 => true,
+                        _ => {
+                            let p = t.parent().expect("below the root");
+                            let pd = u32::from(d - 1);
+                            let (px, py, pz) = (p.x - (root.x << pd), p.y - (root.y << pd), p.z - (root.z << pd));
+                            tiles.get(octree_tiles(d - 1) as usize + octree::morton3(px, py, pz) as usize)
+                        }
+                    };
+                    parent_ok && self.available(t)
+                })
+                .collect();
+            for (i, ok) in ok.into_iter().enumerate() {
+                if ok {
+                    tiles.set(first + i);
                 }
-            };
-            if parent_ok && self.available(t) {
-                tiles.set(n);
             }
         }
         (coords, tiles)
     }
 
     /// The child subtrees of the subtree rooted at `root` whose tiles are `tiles`: the tiles one
-    /// level below it that are available under an available tile, as bits and as roots.
+    /// level below it that are candidates under an available tile, as bits and as roots.
     fn children_of(&self, root: TileCoord, tiles: &Bits) -> (Bits, Vec<TileCoord>) {
         let below = 1usize << (3 * u32::from(SUBTREE_LEVELS));
+        let last = octree_tiles(SUBTREE_LEVELS - 1) as usize;
+        let found: Vec<Option<TileCoord>> = (0..below as u64)
+            .into_par_iter()
+            .map(|m| {
+                let (x, y, z) = demorton3(m);
+                let t = root.descendant(SUBTREE_LEVELS, x, y, z);
+                (tiles.get(last + (m >> 3) as usize) && self.candidate(&t)).then_some(t)
+            })
+            .collect();
         let mut children = Bits::zeros(below);
         let mut roots = Vec::new();
-        let last = octree_tiles(SUBTREE_LEVELS - 1) as usize;
-        for m in 0..below as u64 {
-            let (x, y, z) = demorton3(m);
-            let t = root.descendant(SUBTREE_LEVELS, x, y, z);
-            if tiles.get(last + (m >> 3) as usize) && self.available(&t) {
-                children.set(m as usize);
+        for (m, t) in found.into_iter().enumerate() {
+            if let Some(t) = t {
+                children.set(m);
                 roots.push(t);
             }
         }
