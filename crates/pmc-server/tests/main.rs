@@ -14,3 +14,4 @@ mod jobs;
 mod listen;
 mod nav;
 mod relief;
+mod tiles;

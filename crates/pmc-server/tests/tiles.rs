@@ -1,0 +1,124 @@
+//! The 3D Tiles of the served planet (`docs/specs/tiles-v1.md`): the tileset, its subtree files
+//! and contents over HTTP, the same bytes as the library's, errors for bad paths, and new URLs
+//! after an edit.
+
+use crate::common::{get, send, small_config};
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use pmc_server::{router, AppState, ServerConfig};
+use serde_json::{json, Value};
+
+/// The URLs of a subtree file's contents and child subtree files (relative to it).
+fn uris(node: &Value, out: &mut Vec<String>) {
+    if let Some(u) = node["content"]["uri"].as_str() {
+        out.push(u.to_string());
+    }
+    for c in node["children"].as_array().into_iter().flatten() {
+        uris(c, out);
+    }
+}
+
+/// `../../../../../content/...` from `/tiles/rN/subtrees/F/L/X/Y/Z.json` is `/tiles/rN/content/...`.
+fn resolve(rev: &str, uri: &str) -> String {
+    format!("/tiles/{rev}/{}", uri.trim_start_matches("../../../../../"))
+}
+
+#[tokio::test]
+async fn the_tileset_its_subtrees_and_contents_are_served() {
+    let app = router(AppState::new(small_config()).unwrap());
+    let r = get(&app, "/tiles/tileset.json").await;
+    assert_eq!(r.status, StatusCode::OK);
+    assert_eq!(r.header("cache-control"), Some("no-cache"));
+    assert_eq!(r.header("access-control-allow-origin"), Some("*"));
+    let ts = r.json();
+    assert_eq!(ts["asset"]["version"], "1.1");
+    assert_eq!(ts["extras"]["pmc"]["frame"], "sphere");
+    assert_eq!(ts["extras"]["pmc"]["revision"], 0);
+    let faces = ts["root"]["children"].as_array().unwrap();
+    assert_eq!(faces.len(), 6);
+    // Walk every subtree file and fetch every content it names.
+    let mut todo: Vec<String> = faces
+        .iter()
+        .map(|f| format!("/tiles/{}", f["content"]["uri"].as_str().unwrap()))
+        .collect();
+    let (mut subtrees, mut contents) = (0, 0);
+    while let Some(url) = todo.pop() {
+        let r = get(&app, &url).await;
+        assert_eq!(r.status, StatusCode::OK, "{url}: {}", String::from_utf8_lossy(&r.body));
+        assert_eq!(r.header("content-type"), Some("application/json"));
+        subtrees += 1;
+        let mut found = Vec::new();
+        uris(&r.json()["root"], &mut found);
+        for u in found {
+            let abs = resolve("r0", &u);
+            if abs.ends_with(".json") {
+                todo.push(abs);
+            } else {
+                let c = get(&app, &abs).await;
+                assert_eq!(c.status, StatusCode::OK, "{abs}");
+                assert_eq!(c.header("content-type"), Some("model/gltf-binary"));
+                assert_eq!(&c.body[..4], b"glTF");
+                contents += 1;
+            }
+        }
+    }
+    assert!(
+        subtrees >= 6 && contents > 20,
+        "{subtrees} subtree files, {contents} contents"
+    );
+}
+
+#[tokio::test]
+async fn bad_tile_paths_get_a_reason() {
+    let app = router(AppState::new(small_config()).unwrap());
+    for (uri, status) in [
+        ("/tiles/r0/subtrees/top/0/0/0/0.subtree", StatusCode::NOT_FOUND),
+        ("/tiles/r0/subtrees/top/1/0/0/0.json", StatusCode::NOT_FOUND),
+        ("/tiles/r0/subtrees/up/0/0/0/0.json", StatusCode::BAD_REQUEST),
+        ("/tiles/x0/subtrees/top/0/0/0/0.json", StatusCode::BAD_REQUEST),
+        ("/tiles/r9/subtrees/top/0/0/0/0.json", StatusCode::NOT_FOUND),
+        ("/tiles/r0/content/top/9/0/0/0.glb", StatusCode::NOT_FOUND),
+        ("/tiles/r0/content/top/0/5/0/0.glb", StatusCode::NOT_FOUND),
+        ("/tiles/r0/content/top/0/0/0/-1.glb", StatusCode::BAD_REQUEST),
+        ("/tiles/r0/other/top/0/0/0/0.glb", StatusCode::NOT_FOUND),
+    ] {
+        let r = get(&app, uri).await;
+        assert_eq!(r.status, status, "{uri}: {}", String::from_utf8_lossy(&r.body));
+        assert!(r.json()["error"].as_str().is_some_and(|e| !e.is_empty()), "{uri}");
+    }
+}
+
+#[tokio::test]
+async fn an_edit_gives_the_tileset_new_urls() {
+    let dir = std::env::temp_dir().join(format!("pmc-server-tiles-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = ServerConfig {
+        world: Some(dir.join("w.pmcw")),
+        ..small_config()
+    };
+    let app = router(AppState::new(config).unwrap());
+    let before = get(&app, "/tiles/tileset.json").await.json();
+    assert_eq!(before["extras"]["pmc"]["revision"], 0);
+    assert!(before["root"]["children"][0]["content"]["uri"]
+        .as_str()
+        .unwrap()
+        .starts_with("r0/"));
+    let planet = get(&app, "/api/v1/planet").await.json();
+    let top = planet["radius"].as_f64().unwrap();
+    let edit = json!({"brush": "remove", "x": 0.0, "y": top * 0.97, "z": 0.0, "radius": 8.0});
+    let req = Request::post("/api/v1/edits")
+        .header("content-type", "application/json")
+        .body(Body::from(edit.to_string()))
+        .unwrap();
+    let r = send(&app, req).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
+    let after = get(&app, "/tiles/tileset.json").await.json();
+    assert_eq!(after["extras"]["pmc"]["revision"], 1);
+    assert_eq!(after["extras"]["pmc"]["edits"], 1);
+    assert!(after["root"]["children"][0]["content"]["uri"]
+        .as_str()
+        .unwrap()
+        .starts_with("r1/"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
