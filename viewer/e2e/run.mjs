@@ -20,9 +20,9 @@
 //                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
-//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9, step 15
-//                   and CesiumJS's, step 19, run in browsers of their own beside the others; the
-//                   soak, step 18, runs last and alone)
+//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9, and
+//                   CesiumJS's, step 19, run in browsers of their own beside the others; the soak,
+//                   step 18, runs last and alone)
 //   PMC_E2E_GL      llvmpipe or swiftshader: the software renderer of WebGL (by default Mesa's
 //                   llvmpipe where installed; the flights always draw with SwiftShader)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
@@ -70,17 +70,17 @@ for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => void fail(`interr
 const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndModes, closeup];
 /**
  * Then those that need the real `pmc serve` (the mock has no /path, /navgrid or editing API), and
- * the colours by place and the sea over true-scale planets (servers of their own).
+ * the colours by place and the sea over true-scale planets, and the sea by the data (servers of
+ * their own).
  */
-const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays, levelSwitch];
+const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays, levelSwitch, seaByData];
 /**
  * The flights over true-scale planets (the earth preset, an elevation model) and the default
- * planet's levels of detail, the sea by the data, then the planet's 3D Tiles in CesiumJS, each
- * with servers of their own: in a
- * browser of their own beside the others (PMC_E2E_LANES, by default 2), the two lanes of about the
+ * planet's levels of detail, then the planet's 3D Tiles in CesiumJS, each with servers of their
+ * own: in a browser of their own beside the others (PMC_E2E_LANES, by default 2), the two lanes of about the
  * same length.
  */
-const SECOND_LANE = [lodEarth, elevationModel, lodDefault, seaByData, cesiumTiles];
+const SECOND_LANE = [lodEarth, elevationModel, lodDefault, cesiumTiles];
 /** The steps whose pictures with back faces flagged are drawn by FLIGHTS_GL (harness.mjs). */
 const FLIGHTS = new Set([lodEarth, elevationModel, lodDefault]);
 /** Then, alone on the machine (it compares the times of its views): the soak. */
