@@ -52,8 +52,8 @@ pub struct GenerateArgs {
 /// Most chunks a `--region` export may hold.
 const REGION_BUDGET: usize = 200_000;
 
-/// Parses `--region LAT,LON,RADIUS_M`.
-fn parse_region(s: &str) -> Result<(f64, f64, f64), CliError> {
+/// Parses `--region LAT,LON,RADIUS_M` (of `pmc generate` and `pmc tiles bake`).
+pub(crate) fn parse_region(s: &str) -> Result<(f64, f64, f64), CliError> {
     let err = |why: String| CliError::Region(format!("{s}: {why}; give LAT,LON,RADIUS_M (degrees, degrees, metres)"));
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {

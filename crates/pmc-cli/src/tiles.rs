@@ -91,20 +91,8 @@ pub fn frame_for(planet: &Planet, arg: FrameArg) -> TileFrame {
 }
 
 fn parse_region(s: &str) -> Result<Region, CliError> {
-    let err = |why: String| CliError::Region(format!("{s}: {why}; give LAT,LON,RADIUS_M (degrees, degrees, metres)"));
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(err(format!("expected 3 numbers, got {}", parts.len())));
-    }
-    let num = |name: &str, t: &str| {
-        t.parse::<f64>()
-            .map_err(|_| err(format!("the {name} {t:?} is not a number")))
-    };
-    Ok(Region {
-        lat: num("latitude", parts[0])?,
-        lon: num("longitude", parts[1])?,
-        radius: num("radius", parts[2])?,
-    })
+    let (lat, lon, radius) = crate::generate::parse_region(s)?;
+    Ok(Region { lat, lon, radius })
 }
 
 /// Runs `pmc tiles`.

@@ -70,17 +70,7 @@ pub fn write_tile_glb<W: Write>(
 ) -> Result<u64, ExportError> {
     let meshes = std::slice::from_ref(mesh);
     let checked = check_meshes(meshes)?;
-    let mut b = Builder {
-        root: gj::Root::default(),
-        blobs: Vec::new(),
-        len: 0,
-        translations: Vec::new(),
-    };
-    b.root.asset = gj::Asset {
-        version: "2.0".to_string(),
-        generator: Some(generator.to_string()),
-        ..Default::default()
-    };
+    let mut b = Builder::new(generator);
     let node = match checked.first() {
         Some(c) => {
             let terrain = b.root.push(material("terrain", [1.0; 4], 0.9, false));
@@ -184,6 +174,25 @@ struct Builder<'a> {
 
 fn align4(x: u64) -> u64 {
     x.div_ceil(4) * 4
+}
+
+impl Builder<'_> {
+    /// An empty glTF 2.0 document written by `generator`.
+    fn new(generator: &str) -> Self {
+        Builder {
+            root: gj::Root {
+                asset: gj::Asset {
+                    version: "2.0".to_string(),
+                    generator: Some(generator.to_string()),
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            blobs: Vec::new(),
+            len: 0,
+            translations: Vec::new(),
+        }
+    }
 }
 
 impl<'a> Builder<'a> {
@@ -427,17 +436,7 @@ pub(crate) fn write<W: Write>(meshes: &[ChunkMesh], meta: &ExportMeta, out: W) -
         )));
     }
 
-    let mut b = Builder {
-        root: gj::Root::default(),
-        blobs: Vec::new(),
-        len: 0,
-        translations: Vec::new(),
-    };
-    b.root.asset = gj::Asset {
-        version: "2.0".to_string(),
-        generator: Some(meta.generator.clone()),
-        ..Default::default()
-    };
+    let mut b = Builder::new(&meta.generator);
     let planet = b.root.push(gj::Node {
         name: Some("planet".to_string()),
         ..Default::default()

@@ -35,7 +35,7 @@
 //! own column there.
 
 use crate::mesher::{is_solid, Ctx};
-use crate::transition::ear_clip_closed;
+use crate::transition::{ear_clip_closed, solid_runs};
 use pmc_geometry::glam::DVec2;
 use pmc_geometry::{ChunkSide, EdgeKey};
 use std::collections::HashMap;
@@ -118,16 +118,13 @@ impl Ctx<'_> {
             return i;
         }
         let grad = self.gradient(v);
-        let rel = g.position(v.0, v.1, v.2) - g.origin;
-        let out = &mut *self.out;
-        let idx = out.positions.len() as u32;
-        let high = rel.as_vec3();
-        out.positions.push(high.to_array());
-        out.positions_low.push((rel - high.as_dvec3()).as_vec3().to_array());
-        out.normals.push((-grad).as_vec3().to_array());
         let key = g.voxel_key(v.0, v.1, v.2);
-        out.edge_keys.push(EdgeKey::new(key, key));
-        out.vertex_edges.push([flat as u32, flat as u32]);
+        let idx = self.push_raw(
+            g.position(v.0, v.1, v.2),
+            grad,
+            EdgeKey::new(key, key),
+            [flat as u32; 2],
+        );
         voxels.insert(flat, idx);
         idx
     }
@@ -177,14 +174,7 @@ impl Ctx<'_> {
                 if (0..4).all(sol) || !(0..4).any(sol) {
                     continue;
                 }
-                for end in 0..4 {
-                    if !sol(end) || sol(end + 1) {
-                        continue;
-                    }
-                    let mut start = end;
-                    while sol(start + 3) {
-                        start = (start + 3) % 4;
-                    }
+                for (end, start) in solid_runs(sol) {
                     let exit = self.plane_cut(pl, c[end], c[(end + 1) % 4]);
                     let entry = self.plane_cut(pl, c[(start + 3) % 4], c[start]);
                     segs.push((exit, entry));

@@ -108,30 +108,9 @@ impl Mesher {
         transitions: &[crate::transition::Transition],
         out: &mut ChunkMesh,
     ) {
-        assert_eq!(
-            densities.len(),
-            grid.sample_count(),
-            "densities must cover the padded chunk grid"
-        );
-        self.start(grid, out);
-        let tables = &*TABLES;
-        let mut ctx = Ctx {
-            grid,
-            densities,
-            mesher: self,
-            out,
-        };
-        if grid.padded <= 128 {
-            march_bit_rows(&mut ctx, tables);
-        } else {
-            march_plain(&mut ctx, tables);
-        }
-        ctx.emit_transitions(transitions);
-        finish_normals(out);
+        self.march(grid, densities, out, |ctx| ctx.emit_transitions(transitions));
     }
-}
 
-impl Mesher {
     /// Meshes one chunk as [`Mesher::mesh`] does and adds its caps: the solid part of each of its
     /// six sides, so the mesh bounds a closed solid on its own and no neighbour of any level
     /// beside it can open a crack into it (see [`crate::caps`]). Cap vertices on the chunk's
@@ -140,6 +119,17 @@ impl Mesher {
     /// # Panics
     /// If `densities.len() != grid.sample_count()`.
     pub fn mesh_closed(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh) {
+        self.march(grid, densities, out, |ctx| {
+            // A chunk with no surface has no cap either: it is all solid or all air.
+            if !ctx.out.indices.is_empty() {
+                ctx.emit_caps();
+            }
+        });
+    }
+
+    /// Marches every cube of the chunk into `out` (cleared first), lets `then` add to the mesh
+    /// (seams, caps), and normalises the normals.
+    fn march(&mut self, grid: &ChunkGrid, densities: &[f32], out: &mut ChunkMesh, then: impl FnOnce(&mut Ctx<'_>)) {
         assert_eq!(
             densities.len(),
             grid.sample_count(),
@@ -158,10 +148,7 @@ impl Mesher {
         } else {
             march_plain(&mut ctx, tables);
         }
-        // A chunk with no surface has no cap either: it is all solid or all air.
-        if !ctx.out.indices.is_empty() {
-            ctx.emit_caps();
-        }
+        then(&mut ctx);
         finish_normals(out);
     }
 }
@@ -430,18 +417,24 @@ impl Ctx<'_> {
         let ps = g.position(s.0, s.1, s.2);
         let pos = pf + (ps - pf) * t;
         let grad = gf + (gs - gf) * t;
-        // Stored unnormalised; `finish_normals` normalises them all in one pass.
-        let rel = pos - g.origin;
+        let key = EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2));
+        let flat = |x: (usize, usize, usize)| g.index(x.0, x.1, x.2) as u32;
+        self.push_raw(pos, grad, key, [flat(f), flat(s)])
+    }
+
+    /// Pushes a vertex at world position `pos` with density gradient `grad` (its normal is
+    /// `-grad`, stored unnormalised: `finish_normals` normalises them all in one pass), its key
+    /// and its grid edge; returns its index.
+    pub(crate) fn push_raw(&mut self, pos: DVec3, grad: DVec3, key: EdgeKey, edge: [u32; 2]) -> u32 {
+        let rel = pos - self.grid.origin;
         let out = &mut *self.out;
         let idx = out.positions.len() as u32;
         let high = rel.as_vec3();
         out.positions.push(high.to_array());
         out.positions_low.push((rel - high.as_dvec3()).as_vec3().to_array());
         out.normals.push((-grad).as_vec3().to_array());
-        out.edge_keys
-            .push(EdgeKey::new(g.voxel_key(v.0, v.1, v.2), g.voxel_key(w.0, w.1, w.2)));
-        let flat = |x: (usize, usize, usize)| g.index(x.0, x.1, x.2) as u32;
-        out.vertex_edges.push([flat(f), flat(s)]);
+        out.edge_keys.push(key);
+        out.vertex_edges.push(edge);
         idx
     }
 

@@ -280,16 +280,7 @@ impl Ctx<'_> {
         if (0..4).all(sol) || !(0..4).any(sol) {
             return;
         }
-        // Each maximal run of solid corners, from `start` to `end` (cyclic), is cut off by one
-        // segment from the cut after `end` to the cut before `start`.
-        for end in 0..4 {
-            if !sol(end) || sol(end + 1) {
-                continue;
-            }
-            let mut start = end;
-            while sol(start + 3) {
-                start = (start + 3) % 4;
-            }
+        for (end, start) in solid_runs(sol) {
             let exit = self.cut(st, s, x0, y0, c[end], c[(end + 1) % 4], size, cache);
             let entry = self.cut(st, s, x0, y0, c[(start + 3) % 4], c[start], size, cache);
             segs.push(if reverse { (entry, exit) } else { (exit, entry) });
@@ -490,6 +481,25 @@ impl Ctx<'_> {
             }
         }
     }
+}
+
+/// The maximal runs of solid corners of a square whose corners (counter-clockwise) are solid
+/// where `sol` says so, as `(end, start)`: each run, from `start` to `end` (cyclic), is cut off by
+/// one segment from the cut after `end` to the cut before `start` (marching squares, diagonally
+/// opposite solid corners kept apart). `sol` takes any index and reads it modulo 4.
+pub(crate) fn solid_runs(sol: impl Fn(usize) -> bool) -> Vec<(usize, usize)> {
+    let mut runs = Vec::with_capacity(2);
+    for end in 0..4 {
+        if !sol(end) || sol(end + 1) {
+            continue;
+        }
+        let mut start = end;
+        while sol(start + 3) {
+            start = (start + 3) % 4;
+        }
+        runs.push((end, start));
+    }
+    runs
 }
 
 /// Triangulates a simple polygon (either orientation) by ear clipping; the triangles keep the
