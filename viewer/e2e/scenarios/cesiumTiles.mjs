@@ -4,7 +4,7 @@
 // an imported elevation model, from orbit down to 2 m: CesiumJS picks each tile's level on its
 // own, and the closed tiles leave no crack into a solid.
 
-import { existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { DEM_SOURCE, PMC_BIN, artifacts, check, cleanups, log, run, viewerDir } from '../harness.mjs';
@@ -112,7 +112,7 @@ async function views(t, label, server, lat, lon) {
       }
     }
     const file = join(artifacts, `cesium-${label}-${view}.png`);
-    (await import('node:fs')).writeFileSync(file, png);
+    writeFileSync(file, png);
     const px = countPixels(png);
     log(`  ${label} ${view}: ${s.tiles} tiles, ${s.triangles} triangles, ${px.magenta} magenta (the surface's back faces; ${px.isolated} of them pinholes) and ${px.cyan} cyan (caps' back faces) pixels, terrain on ${((100 * px.terrain) / px.total).toFixed(0)}% of the view, ${s.seconds.toFixed(1)} s`);
     check(
@@ -135,9 +135,33 @@ async function views(t, label, server, lat, lon) {
   }
 }
 
+/**
+ * The page as a user opens it (lit, its sky and globe, the Earth's materials per pixel): from
+ * orbit, no console error (the harness checks), and colour on the planet.
+ */
+async function asSeen(t, server) {
+  const { page } = t;
+  await page.goto(`${server.base}cesium/?lat=39&lon=0&height=12000000`, { waitUntil: 'load', timeout: 60_000 });
+  await page.waitForFunction(() => window.__pmcCesium !== undefined, null, { timeout: 60_000 });
+  await page.evaluate(() => window.__pmcCesium.loaded());
+  const png = await page.screenshot({ type: 'png' });
+  const file = join(artifacts, 'cesium-earth-as-seen.png');
+  writeFileSync(file, png);
+  const img = decodePng(png);
+  let coloured = 0;
+  for (let i = 0; i < img.data.length; i += 4) {
+    const c = [img.data[i], img.data[i + 1], img.data[i + 2]];
+    if (Math.max(...c) - Math.min(...c) > 30) coloured += 1;
+  }
+  const share = coloured / (img.width * img.height);
+  log(`  earth as seen from orbit: ${(100 * share).toFixed(0)}% of the view in colour`);
+  check(share > 0.1, `the planet as seen in CesiumJS has colour on ${(100 * share).toFixed(1)}% of the view; see ${file}`);
+}
+
 export async function scenario(t) {
   check(existsSync(join(CESIUM_JS, 'Cesium.js')), `no CesiumJS at ${CESIUM_JS}: run npm ci in examples/cesium`);
   const earth = await startPmcServe(null, { extra: ['--preset', 'earth', '--cesium-js', CESIUM_JS] });
+  await asSeen(t, earth);
   await views(t, 'earth', earth, 39, 0);
   await earth.stop();
   // an elevation model (ETOPO5 where installed, as in step 11: the file it imported, or a new one)
