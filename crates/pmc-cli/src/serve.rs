@@ -105,11 +105,7 @@ pub fn run(args: &ServeArgs, given: &dyn Fn(&str) -> bool) -> Result<(), CliErro
         threads: args.threads,
         world: args.world.clone(),
         imagery: args.imagery.clone(),
-        tiles_frame: match args.tiles_frame {
-            crate::tiles::FrameArg::Auto => pmc_server::tiles_api::TilesFrame::Auto,
-            crate::tiles::FrameArg::Wgs84 => pmc_server::tiles_api::TilesFrame::Wgs84,
-            crate::tiles::FrameArg::Sphere => pmc_server::tiles_api::TilesFrame::Sphere,
-        },
+        tiles_frame: args.tiles_frame.into(),
         cesium_js: args.cesium_js.clone(),
         edit_limits: EditLimits {
             max_brush_radius: args.max_brush_radius,

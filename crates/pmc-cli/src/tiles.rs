@@ -5,9 +5,8 @@ use crate::planet_args::PlanetArgs;
 use crate::work;
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pmc_planet::Planet;
 use pmc_tiles::bake::BakeStats;
-use pmc_tiles::{Region, TileFrame, TileOptions, TileSet};
+use pmc_tiles::{FrameChoice, Region, TileOptions, TileSet};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -80,13 +79,13 @@ pub struct BakeArgs {
     quiet: bool,
 }
 
-/// The frame for `planet` given `--frame`.
-pub fn frame_for(planet: &Planet, arg: FrameArg) -> TileFrame {
-    let datum = planet.datum_radius();
-    match arg {
-        FrameArg::Auto => TileFrame::default_for(datum),
-        FrameArg::Wgs84 => TileFrame::Wgs84 { datum },
-        FrameArg::Sphere => TileFrame::Sphere,
+impl From<FrameArg> for FrameChoice {
+    fn from(arg: FrameArg) -> FrameChoice {
+        match arg {
+            FrameArg::Auto => FrameChoice::Auto,
+            FrameArg::Wgs84 => FrameChoice::Wgs84,
+            FrameArg::Sphere => FrameChoice::Sphere,
+        }
     }
 }
 
@@ -112,7 +111,7 @@ fn bake(args: &BakeArgs) -> Result<(), CliError> {
         None => (args.planet.planet()?, None),
     };
     let region = args.region.as_deref().map(parse_region).transpose()?;
-    let frame = frame_for(&planet, args.frame);
+    let frame = FrameChoice::from(args.frame).frame(planet.datum_radius());
     let pool = work::thread_pool(args.threads)?;
     let extras = pmc_tiles::planet_extras(&planet, edits);
     let planet = Arc::new(planet);

@@ -72,7 +72,7 @@ pub struct ServerConfig {
     /// no imagery.
     pub imagery: Option<PathBuf>,
     /// Where the 3D Tiles of `/tiles/` are placed (`docs/specs/tiles-v1.md`).
-    pub tiles_frame: crate::tiles_api::TilesFrame,
+    pub tiles_frame: pmc_tiles::FrameChoice,
     /// CesiumJS's built files (npm's `cesium/Build/Cesium`), served at `/cesium/Cesium/` under
     /// the example page at `/cesium/`. `None`: no CesiumJS page.
     pub cesium_js: Option<PathBuf>,
@@ -105,7 +105,7 @@ impl Default for ServerConfig {
             base_cache_chunks: 256,
             mesher: Mesher::Volumetric,
             imagery: None,
-            tiles_frame: crate::tiles_api::TilesFrame::Auto,
+            tiles_frame: pmc_tiles::FrameChoice::Auto,
             cesium_js: None,
         }
     }

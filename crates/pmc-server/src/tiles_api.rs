@@ -24,22 +24,10 @@ use axum::extract::{Path, State};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use pmc_geometry::Face;
-use pmc_tiles::{TileCoord, TileFrame, TileOptions, TileSet};
+use pmc_tiles::{FrameChoice, TileCoord, TileOptions, TileSet};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 use tokio::sync::{watch, Semaphore};
-
-/// Where the served tiles are placed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum TilesFrame {
-    /// WGS84 for a planet of the Earth's size, else its sphere.
-    #[default]
-    Auto,
-    /// On the WGS84 ellipsoid.
-    Wgs84,
-    /// On the planet's own sphere.
-    Sphere,
-}
 
 /// A file made: the planet's revision, whether it is a content (else a subtree file), the tile.
 type Key = (u64, bool, TileCoord);
@@ -48,7 +36,7 @@ type Built = Result<Option<Bytes>, Arc<str>>;
 
 /// The tiles of the served planet.
 pub(crate) struct ServedTiles {
-    frame: TilesFrame,
+    frame: FrameChoice,
     cache: Mutex<ByteCache<Key, Option<Bytes>>>,
     building: Mutex<HashMap<Key, watch::Receiver<Option<Built>>>>,
     permits: Arc<Semaphore>,
@@ -58,7 +46,7 @@ pub(crate) struct ServedTiles {
 
 impl ServedTiles {
     /// Tiles placed in `frame`, with `cache_bytes` of files made and at most `builds` made at once.
-    pub(crate) fn new(frame: TilesFrame, cache_bytes: u64, builds: usize) -> ServedTiles {
+    pub(crate) fn new(frame: FrameChoice, cache_bytes: u64, builds: usize) -> ServedTiles {
         ServedTiles {
             frame,
             cache: Mutex::new(ByteCache::new(cache_bytes)),
@@ -84,12 +72,7 @@ async fn tileset(state: &AppState) -> Result<(u64, Arc<TileSet>), ApiError> {
         }
     }
     let errors = state.lod_errors_of_default().await.map_err(ApiError::internal)?;
-    let datum = planet.datum_radius();
-    let frame = match tiles.frame {
-        TilesFrame::Auto => TileFrame::default_for(datum),
-        TilesFrame::Wgs84 => TileFrame::Wgs84 { datum },
-        TilesFrame::Sphere => TileFrame::Sphere,
-    };
+    let frame = tiles.frame.frame(planet.datum_radius());
     let generator = format!("pmc {}", env!("CARGO_PKG_VERSION"));
     let set = TileSet::new(planet, (*errors).clone(), frame, TileOptions::default(), &generator)
         .map_err(|e| ApiError::not_found(format!("this planet has no 3D Tiles: {e}")))?;

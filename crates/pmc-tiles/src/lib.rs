@@ -75,6 +75,30 @@ pub enum TilesError {
     },
 }
 
+/// Which frame a planet's tiles go in, before its datum is known: what `--frame` and
+/// `--tiles-frame` say.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FrameChoice {
+    /// WGS84 for a planet of the Earth's size, else its sphere ([`TileFrame::default_for`]).
+    #[default]
+    Auto,
+    /// On the WGS84 ellipsoid.
+    Wgs84,
+    /// On the planet's own sphere.
+    Sphere,
+}
+
+impl FrameChoice {
+    /// The frame of a planet of datum radius `datum`.
+    pub fn frame(self, datum: f64) -> TileFrame {
+        match self {
+            FrameChoice::Auto => TileFrame::default_for(datum),
+            FrameChoice::Wgs84 => TileFrame::Wgs84 { datum },
+            FrameChoice::Sphere => TileFrame::Sphere,
+        }
+    }
+}
+
 /// A region of the planet to tile: the tiles whose bounding spheres meet the ball of `radius`
 /// metres around the place at `lat`, `lon` (degrees) on the datum sphere.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -401,12 +425,17 @@ impl TileSet {
     /// for the others. Positions are `f32` relative to the tile's sphere's centre in glTF axes, the
     /// centre the node's `f64` translation.
     pub fn content(&self, t: &TileCoord) -> Result<Option<Vec<u8>>, TilesError> {
-        let Some(key) = self.tiling.key(t).filter(|_| self.has_content(t)) else {
-            return Ok(None);
-        };
         if !self.available(t) {
             return Ok(None);
         }
+        self.content_of_available(t)
+    }
+
+    /// [`TileSet::content`] of a tile known to be available (a subtree's build has tested it).
+    fn content_of_available(&self, t: &TileCoord) -> Result<Option<Vec<u8>>, TilesError> {
+        let Some(key) = self.tiling.key(t).filter(|_| self.has_content(t)) else {
+            return Ok(None);
+        };
         let mut mesh = self.closed_mesh(key);
         let origin = mesh.origin;
         separate_caps(&mut mesh, self.planet_sphere(t).0 - origin);
@@ -462,7 +491,7 @@ impl TileSet {
                 .into_par_iter()
                 .map(|n| {
                     if tiles.get(n) {
-                        self.content(&coords[n])
+                        self.content_of_available(&coords[n])
                     } else {
                         Ok(None)
                     }
@@ -471,7 +500,7 @@ impl TileSet {
         } else {
             vec![None; count]
         };
-        let (_, child_roots) = self.children_of(root, &tiles);
+        let child_roots = self.children_of(root, &tiles);
         // URLs are relative to the subtree file, `subtrees/FACE/LEVEL/X/Y/Z.json`.
         let up = "../../../../../";
         let index: std::collections::HashMap<TileCoord, usize> =
@@ -572,34 +601,25 @@ impl TileSet {
     }
 
     /// The child subtrees of the subtree rooted at `root` whose tiles are `tiles`: the tiles one
-    /// level below it that are candidates under an available tile, as bits and as roots.
-    fn children_of(&self, root: TileCoord, tiles: &Bits) -> (Bits, Vec<TileCoord>) {
-        let below = 1usize << (3 * u32::from(SUBTREE_LEVELS));
+    /// level below it that are candidates under an available tile, in Morton order.
+    fn children_of(&self, root: TileCoord, tiles: &Bits) -> Vec<TileCoord> {
+        let below = 1u64 << (3 * u32::from(SUBTREE_LEVELS));
         let last = octree_tiles(SUBTREE_LEVELS - 1) as usize;
-        let found: Vec<Option<TileCoord>> = (0..below as u64)
+        (0..below)
             .into_par_iter()
-            .map(|m| {
+            .filter_map(|m| {
                 let (x, y, z) = demorton3(m);
                 let t = root.descendant(SUBTREE_LEVELS, x, y, z);
                 (tiles.get(last + (m >> 3) as usize) && self.candidate(&t)).then_some(t)
             })
-            .collect();
-        let mut children = Bits::zeros(below);
-        let mut roots = Vec::new();
-        for (m, t) in found.into_iter().enumerate() {
-            if let Some(t) = t {
-                children.set(m);
-                roots.push(t);
-            }
-        }
-        (children, roots)
+            .collect()
     }
 
     /// The roots of the available child subtrees of the subtree rooted at `root`, from the
     /// availability alone (nothing is meshed).
     pub fn child_subtrees(&self, root: TileCoord) -> Vec<TileCoord> {
         let (_, tiles) = self.availability(root);
-        self.children_of(root, &tiles).1
+        self.children_of(root, &tiles)
     }
 
     /// The tileset JSON. `prefix` goes before every subtree URL (for example a revision,
