@@ -25,6 +25,9 @@ step "install external validators"
 if [ ! -d tools/gltf-validate/node_modules/gltf-validator ]; then
   (cd tools/gltf-validate && npm ci --no-audit --no-fund --loglevel=error)
 fi
+if [ ! -d tools/tiles-check/node_modules/@loaders.gl/3d-tiles ]; then
+  (cd tools/tiles-check && npm ci --no-audit --no-fund --loglevel=error)
+fi
 if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 fi
@@ -113,6 +116,8 @@ rm -rf "$OUT/tiles"
 "$PMC" tiles bake --quiet --preset moon --seed 3 --n-c 8 --n-t 16 -o "$OUT/tiles"
 find "$OUT/tiles/content" -name '*.glb' -print0 | xargs -0 node tools/gltf-validate/validate.mjs > "$OUT/tiles-validate.log"
 echo "gltf-validator: $(grep -c ': ok 0 errors' "$OUT/tiles-validate.log") tile contents valid"
+# The bake's tileset JSON against the 3D Tiles 1.1 schemas, loaded by loaders.gl (prints its summary)
+node tools/tiles-check/check.mjs "$OUT/tiles"
 
 # The sphere preset's radius: d_b + T/2 + 0.37 l_d with T = l_d n_t d_c.
 R=$(python3 -c "print(1744 + 4*16*2/2 + 0.37*4)")
@@ -125,9 +130,9 @@ step "viewer: end-to-end tests in headless Chromium against pmc serve"
 
 step "all checks passed"
 # One closing line: the Rust suite's totals plus the external checks above (the validator run
-# and the two trimesh checks, the tiles' validator run; any failure there has already stopped
-# the script).
-EXTERNAL_CHECKS=4
+# and the two trimesh checks, the tiles' validator run, the tiles' schema and loaders.gl check;
+# any failure there has already stopped the script).
+EXTERNAL_CHECKS=5
 VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
 awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log
