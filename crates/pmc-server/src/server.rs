@@ -70,6 +70,11 @@ pub fn router(state: AppState) -> Router {
             "/tiles/{rev}/{kind}/{face}/{level}/{x}/{y}/{file}",
             get(tiles_api::tile_file),
         )
+        .route("/tiles/{frame}/tileset.json", get(tiles_api::tileset_json_framed))
+        .route(
+            "/tiles/{frame}/{rev}/{kind}/{face}/{level}/{x}/{y}/{file}",
+            get(tiles_api::tile_file_framed),
+        )
         .route("/api", any(api::not_found))
         .route("/api/", any(api::not_found))
         .route("/api/{*rest}", any(api::not_found))

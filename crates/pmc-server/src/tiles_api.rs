@@ -7,6 +7,9 @@
 //! - `GET /tiles/r<N>/subtrees/FACE/LEVEL/X/Y/Z.json`: a subtree file (an external tileset of
 //!   three levels of tiles).
 //! - `GET /tiles/r<N>/content/FACE/LEVEL/X/Y/Z.glb`: a tile's glTF content.
+//! - `GET /tiles/wgs84/...` and `GET /tiles/sphere/...`: the same, placed in the frame the path
+//!   names whatever the server's `--tiles-frame` (a client drawing the planet as its sphere, as
+//!   PMC's viewer does, asks for `sphere`).
 //!
 //! A subtree file is made from the tiles' availability alone (`pmc_tiles::TileSet::subtree_file`:
 //! nothing meshed), a content when a client asks for it (`pmc_tiles::TileSet::content`); both are
@@ -29,8 +32,40 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 use tokio::sync::{watch, Semaphore};
 
-/// A file made: the planet's revision, whether it is a content (else a subtree file), the tile.
-type Key = (u64, bool, TileCoord);
+/// A file made: the frame, the planet's revision, whether it is a content (else a subtree file),
+/// the tile.
+type Key = (Frame, u64, bool, TileCoord);
+
+/// The frame a URL asks for: the server's (`/tiles/...`) or one named (`/tiles/sphere/...`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Frame {
+    /// The server's `--tiles-frame`.
+    Served,
+    /// On the WGS84 ellipsoid.
+    Wgs84,
+    /// On the planet's sphere.
+    Sphere,
+}
+
+impl Frame {
+    fn named(name: &str) -> Result<Frame, ApiError> {
+        match name {
+            "wgs84" => Ok(Frame::Wgs84),
+            "sphere" => Ok(Frame::Sphere),
+            other => Err(ApiError::not_found(format!(
+                "/tiles/{other}/: a frame is `wgs84` or `sphere`"
+            ))),
+        }
+    }
+
+    fn choice(self, served: FrameChoice) -> FrameChoice {
+        match self {
+            Frame::Served => served,
+            Frame::Wgs84 => FrameChoice::Wgs84,
+            Frame::Sphere => FrameChoice::Sphere,
+        }
+    }
+}
 /// The file's bytes, or `None` for a tile with no content.
 type Built = Result<Option<Bytes>, Arc<str>>;
 
@@ -40,8 +75,8 @@ pub(crate) struct ServedTiles {
     cache: Mutex<ByteCache<Key, Option<Bytes>>>,
     building: Mutex<HashMap<Key, watch::Receiver<Option<Built>>>>,
     permits: Arc<Semaphore>,
-    /// The tileset of the latest revision asked for.
-    tileset: Mutex<Option<(u64, Arc<TileSet>)>>,
+    /// For each frame asked for, the tileset of the latest revision asked for.
+    tilesets: Mutex<HashMap<Frame, (u64, Arc<TileSet>)>>,
 }
 
 impl ServedTiles {
@@ -52,7 +87,7 @@ impl ServedTiles {
             cache: Mutex::new(ByteCache::new(cache_bytes)),
             building: Mutex::new(HashMap::new()),
             permits: Arc::new(Semaphore::new(builds.max(1))),
-            tileset: Mutex::new(None),
+            tilesets: Mutex::new(HashMap::new()),
         }
     }
 }
@@ -61,23 +96,30 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// The tileset of the served planet at its current revision (made once per revision).
-async fn tileset(state: &AppState) -> Result<(u64, Arc<TileSet>), ApiError> {
+/// The tileset of the served planet in `frame` at its current revision (made once per revision).
+async fn tileset(state: &AppState, frame: Frame) -> Result<(u64, Arc<TileSet>), ApiError> {
     let tiles = state.tiles();
     let id = Arc::new(state.config().terrain.clone());
     let (planet, revision) = state.planet(id).await.map_err(ApiError::internal)?;
-    if let Some((r, t)) = lock(&tiles.tileset).as_ref() {
+    if let Some((r, t)) = lock(&tiles.tilesets).get(&frame) {
         if *r == revision {
             return Ok((*r, t.clone()));
         }
     }
     let errors = state.lod_errors_of_default().await.map_err(ApiError::internal)?;
-    let frame = tiles.frame.frame(planet.datum_radius());
+    let choice = frame.choice(tiles.frame);
+    let frame_of_planet = choice.frame(planet.datum_radius());
     let generator = format!("pmc {}", env!("CARGO_PKG_VERSION"));
-    let set = TileSet::new(planet, (*errors).clone(), frame, TileOptions::default(), &generator)
-        .map_err(|e| ApiError::not_found(format!("this planet has no 3D Tiles: {e}")))?;
+    let set = TileSet::new(
+        planet,
+        (*errors).clone(),
+        frame_of_planet,
+        TileOptions::default(),
+        &generator,
+    )
+    .map_err(|e| ApiError::not_found(format!("this planet has no 3D Tiles: {e}")))?;
     let set = Arc::new(set);
-    *lock(&tiles.tileset) = Some((revision, set.clone()));
+    lock(&tiles.tilesets).insert(frame, (revision, set.clone()));
     Ok((revision, set))
 }
 
@@ -93,7 +135,20 @@ fn respond(bytes: Bytes, content_type: &'static str, cache: &'static str) -> Res
 
 /// `GET /tiles/tileset.json`.
 pub async fn tileset_json(State(state): State<AppState>) -> Result<Response, ApiError> {
-    let (revision, set) = tileset(&state).await?;
+    tileset_json_in(&state, Frame::Served).await
+}
+
+/// `GET /tiles/{frame}/tileset.json`.
+pub async fn tileset_json_framed(
+    State(state): State<AppState>,
+    path: Result<Path<String>, PathRejection>,
+) -> Result<Response, ApiError> {
+    let Path(frame) = path.map_err(|e| ApiError::bad_request(format!("malformed tileset path: {e}")))?;
+    tileset_json_in(&state, Frame::named(&frame)?).await
+}
+
+async fn tileset_json_in(state: &AppState, frame: Frame) -> Result<Response, ApiError> {
+    let (revision, set) = tileset(state, frame).await?;
     let edits = state.editing().map(|e| e.current().active);
     let extras = pmc_tiles::planet_extras(set.planet(), edits);
     let mut extras = extras;
@@ -105,6 +160,8 @@ pub async fn tileset_json(State(state): State<AppState>) -> Result<Response, Api
 
 /// The parts of a tile path: revision, kind, face, level, x, y, and the last part `Z.EXT`.
 type TilePath = (String, String, String, String, String, String, String);
+/// A frame's name, then the parts of a tile path.
+type FramedTilePath = (String, String, String, String, String, String, String, String);
 
 /// The tile named by a path, checked against the tileset: 400 when malformed, 404 when not one
 /// of its tiles.
@@ -139,15 +196,9 @@ fn parse(set: &TileSet, p: &TilePath, ext: &str) -> Result<(u64, TileCoord), Api
 
 /// The subtree file rooted at `t` (`content` false) or the content of tile `t`, from the cache,
 /// from the one being made, or made now.
-async fn made(
-    state: &AppState,
-    set: Arc<TileSet>,
-    revision: u64,
-    content: bool,
-    t: TileCoord,
-) -> Result<Option<Bytes>, ApiError> {
+async fn made(state: &AppState, set: Arc<TileSet>, key: Key) -> Result<Option<Bytes>, ApiError> {
     let tiles = state.tiles();
-    let key = (revision, content, t);
+    let (_, _, content, t) = key;
     if let Some(b) = lock(&tiles.cache).get(&key) {
         return Ok(b.clone());
     }
@@ -212,7 +263,7 @@ async fn made(
         }
         if rx.changed().await.is_err() {
             // The one doing it went away before starting: ask again.
-            return Box::pin(made(state, set, revision, content, t)).await;
+            return Box::pin(made(state, set, key)).await;
         }
     }
 }
@@ -224,9 +275,23 @@ pub async fn tile_file(
     path: Result<Path<TilePath>, PathRejection>,
 ) -> Result<Response, ApiError> {
     let Path(p) = path.map_err(|e| ApiError::bad_request(format!("malformed tile path: {e}")))?;
+    tile_file_in(&state, Frame::Served, p).await
+}
+
+/// `GET /tiles/{frame}/{rev}/subtrees/...` and `GET /tiles/{frame}/{rev}/content/...`.
+pub async fn tile_file_framed(
+    State(state): State<AppState>,
+    path: Result<Path<FramedTilePath>, PathRejection>,
+) -> Result<Response, ApiError> {
+    let Path((frame, rev, kind, face, level, x, y, last)) =
+        path.map_err(|e| ApiError::bad_request(format!("malformed tile path: {e}")))?;
+    tile_file_in(&state, Frame::named(&frame)?, (rev, kind, face, level, x, y, last)).await
+}
+
+async fn tile_file_in(state: &AppState, frame: Frame, p: TilePath) -> Result<Response, ApiError> {
     match p.1.as_str() {
-        "subtrees" => subtree_file(&state, p).await,
-        "content" => content_file(&state, p).await,
+        "subtrees" => subtree_file(state, frame, p).await,
+        "content" => content_file(state, frame, p).await,
         other => Err(ApiError::not_found(format!(
             "/tiles/{}/{other}/...: tiles have `subtrees` and `content`",
             p.0
@@ -234,8 +299,8 @@ pub async fn tile_file(
     }
 }
 
-async fn subtree_file(state: &AppState, p: TilePath) -> Result<Response, ApiError> {
-    let (current, set) = tileset(state).await?;
+async fn subtree_file(state: &AppState, frame: Frame, p: TilePath) -> Result<Response, ApiError> {
+    let (current, set) = tileset(state, frame).await?;
     let (revision, t) = parse(&set, &p, ".json")?;
     check_revision(revision, current)?;
     if t.subtree_root() != t {
@@ -246,16 +311,16 @@ async fn subtree_file(state: &AppState, p: TilePath) -> Result<Response, ApiErro
             pmc_tiles::SUBTREE_LEVELS
         )));
     }
-    let b = made(state, set, current, false, t).await?;
+    let b = made(state, set, (frame, current, false, t)).await?;
     let b = b.ok_or_else(|| ApiError::internal("a subtree file is always made"))?;
     Ok(respond(b, "application/json", "public, max-age=3600"))
 }
 
-async fn content_file(state: &AppState, p: TilePath) -> Result<Response, ApiError> {
-    let (current, set) = tileset(state).await?;
+async fn content_file(state: &AppState, frame: Frame, p: TilePath) -> Result<Response, ApiError> {
+    let (current, set) = tileset(state, frame).await?;
     let (revision, t) = parse(&set, &p, ".glb")?;
     check_revision(revision, current)?;
-    match made(state, set, current, true, t).await? {
+    match made(state, set, (frame, current, true, t)).await? {
         Some(glb) => Ok(respond(glb, "model/gltf-binary", "public, max-age=3600")),
         None => Err(ApiError::not_found(format!(
             "tile {}/{} has no content (its subtree file says so)",

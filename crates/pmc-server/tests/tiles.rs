@@ -122,3 +122,50 @@ async fn an_edit_gives_the_tileset_new_urls() {
         .starts_with("r1/"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[tokio::test]
+async fn a_frame_named_in_the_path_places_the_tiles_in_it() {
+    let app = router(AppState::new(small_config()).unwrap());
+    let mut first_content = Vec::new();
+    for frame in ["sphere", "wgs84"] {
+        let r = get(&app, &format!("/tiles/{frame}/tileset.json")).await;
+        assert_eq!(
+            r.status,
+            StatusCode::OK,
+            "{frame}: {}",
+            String::from_utf8_lossy(&r.body)
+        );
+        let ts = r.json();
+        assert_eq!(ts["extras"]["pmc"]["frame"], frame);
+        // The face's subtree file and one of its contents, under the frame's prefix.
+        let face = ts["root"]["children"][0]["content"]["uri"]
+            .as_str()
+            .unwrap()
+            .to_string();
+        let sub = get(&app, &format!("/tiles/{frame}/{face}")).await;
+        assert_eq!(sub.status, StatusCode::OK, "{frame}/{face}");
+        let mut found = Vec::new();
+        uris(&sub.json()["root"], &mut found);
+        let glb = found.iter().find(|u| u.ends_with(".glb")).expect("a content");
+        let c = get(
+            &app,
+            &format!("/tiles/{frame}/{}", resolve("r0", glb).trim_start_matches("/tiles/")),
+        )
+        .await;
+        assert_eq!(c.status, StatusCode::OK, "{frame} {glb}");
+        first_content.push(c.body.to_vec());
+    }
+    // The same tile, placed in two frames: two different files.
+    assert_ne!(first_content[0], first_content[1]);
+    // The unframed URLs are the server's frame (the sphere, for this small planet).
+    let served = get(&app, "/tiles/tileset.json").await.json();
+    assert_eq!(served["extras"]["pmc"]["frame"], "sphere");
+    for uri in ["/tiles/mars/tileset.json", "/tiles/mars/r0/subtrees/top/0/0/0/0.json"] {
+        let r = get(&app, uri).await;
+        assert_eq!(r.status, StatusCode::NOT_FOUND, "{uri}");
+        assert!(
+            r.json()["error"].as_str().unwrap().contains("`wgs84` or `sphere`"),
+            "{uri}"
+        );
+    }
+}

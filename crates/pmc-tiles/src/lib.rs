@@ -248,6 +248,25 @@ fn gltf_axes(e: DVec3) -> DVec3 {
     DVec3::new(e.x, e.z, -e.y)
 }
 
+/// How much a level's geometric error at least exceeds the next finer level's (see
+/// [`strictly_growing`]).
+pub const ERROR_STEP: f64 = 1.0 / 1024.0;
+
+/// The measured level errors (non-decreasing in the level, `pmc_lod`'s running maximum) made
+/// strictly growing wherever they are positive: a level whose error equals the finer one's gets
+/// that error times `1 + ERROR_STEP`. Still an upper bound of the level's error; and a 3D Tiles
+/// client never sees a child whose error is not below its parent's, which some clients
+/// (3DTilesRendererJS) take for a tile to refine past unconditionally.
+fn strictly_growing(mut errors: Vec<f64>) -> Vec<f64> {
+    for l in 1..errors.len() {
+        let finer = errors[l - 1];
+        if finer > 0.0 && errors[l] <= finer * (1.0 + ERROR_STEP) {
+            errors[l] = finer * (1.0 + ERROR_STEP);
+        }
+    }
+    errors
+}
+
 impl TileSet {
     /// The tileset of `planet` placed in `frame`, with the planet's measured geometric error of
     /// each level of detail (`pmc_lod::measure_level_errors`, metres, index = level).
@@ -302,7 +321,7 @@ impl TileSet {
             planet,
             frame,
             tiling,
-            errors,
+            errors: strictly_growing(errors),
             options,
             region,
             generator: generator.to_string(),
@@ -351,8 +370,9 @@ impl TileSet {
         (c, r * (1.0 + CAP_OFFSET + 1e-6))
     }
 
-    /// The tile's geometric error, metres: its level's measured error, stretched by the frame;
-    /// a virtual tile's is twice its children's.
+    /// The tile's geometric error, metres: its level's measured error (made strictly growing
+    /// with the level by at least [`ERROR_STEP`]), stretched by the frame; a virtual tile's is
+    /// twice its children's.
     pub fn geometric_error(&self, t: &TileCoord) -> f64 {
         let stretch = self.frame.stretch(self.tiling.layout().d_b());
         match self.tiling.chunk_level(t.level) {

@@ -577,3 +577,58 @@ fn bad_parameters_are_refused_with_a_reason() {
         assert!(matches!(r, Err(TilesError::Heightfield)));
     }
 }
+
+/// Regression (3DTilesRendererJS 0.5 refined past every tile whose error was not below its
+/// parent's, and stalled on the empty leaves below): the measured errors of the earth preset are
+/// flat over four levels (a running maximum), and the tiles' errors must still fall strictly
+/// from each tile to its children, at every level.
+#[test]
+fn plateau_of_level_errors_gives_strictly_falling_tile_errors() {
+    let layout = Layout::new(4, 8, 500.0, 2.0, 4).unwrap();
+    let planet = Arc::new(Planet::new(PresetKind::Earthlike, 3, layout));
+    let mut errors = pmc_lod::measure_level_errors(&planet, 256, 0x5eed);
+    let levels = errors.len();
+    assert!(levels >= 3);
+    // flat from level 1 up, as the earth preset's are from level 7 to 10
+    for e in errors.iter_mut().skip(1) {
+        *e = 5.0;
+    }
+    let tiles = TileSet::new(
+        planet,
+        errors.clone(),
+        TileFrame::Sphere,
+        TileOptions::default(),
+        "pmc test",
+    )
+    .unwrap();
+    let root = TileCoord::root(Face::Top);
+    let mut t = root;
+    while t.level + 1 < tiles.available_levels() {
+        let child = t.descendant(1, 0, 0, 0);
+        let (e, ec) = (tiles.geometric_error(&t), tiles.geometric_error(&child));
+        if e > 0.0 {
+            assert!(
+                ec < e,
+                "level {} error {ec} not below level {} error {e}",
+                child.level,
+                t.level
+            );
+            // an upper bound of the measured error, by no more than the step per level
+            assert!(e <= 5.0 * (1.0 + pmc_tiles::ERROR_STEP).powi(i32::try_from(levels).unwrap()) * 2f64.powi(8));
+        }
+        t = child;
+    }
+    assert_eq!(tiles.geometric_error(&t), 0.0, "the finest level is the reference");
+    // and in the files: every child below its parent
+    fn falls(node: &Value) {
+        let e = node["geometricError"].as_f64().unwrap();
+        for c in node["children"].as_array().into_iter().flatten() {
+            assert!(e == 0.0 || c["geometricError"].as_f64().unwrap() < e, "{c}");
+            falls(c);
+        }
+    }
+    for (_, b) in all_subtrees(&tiles) {
+        let doc: Value = serde_json::from_slice(&b.subtree).unwrap();
+        falls(&doc["root"]);
+    }
+}
