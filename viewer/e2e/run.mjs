@@ -20,9 +20,9 @@
 //                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
-//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9, and
-//                   CesiumJS's, step 19, run in browsers of their own beside the others; the soak,
-//                   step 18, runs last and alone)
+//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9,
+//                   CesiumJS's, step 19, and the 3D Tiles mode's, step 20, run in browsers of
+//                   their own beside the others; the soak, step 18, runs last and alone)
 //   PMC_E2E_GL      llvmpipe or swiftshader: the software renderer of WebGL (by default Mesa's
 //                   llvmpipe where installed; the flights always draw with SwiftShader)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
@@ -57,6 +57,7 @@ import * as presetSwitch from './scenarios/presetSwitch.mjs';
 import * as seaByData from './scenarios/seaByData.mjs';
 import * as sky from './scenarios/sky.mjs';
 import * as soak from './scenarios/soak.mjs';
+import * as tilesMode from './scenarios/tilesMode.mjs';
 import * as viewsAndModes from './scenarios/viewsAndModes.mjs';
 import { startBackend } from './servers.mjs';
 
@@ -76,11 +77,11 @@ const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndMode
 const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays, levelSwitch, seaByData];
 /**
  * The flights over true-scale planets (the earth preset, an elevation model) and the default
- * planet's levels of detail, then the planet's 3D Tiles in CesiumJS, each with servers of their
- * own: in a browser of their own beside the others (PMC_E2E_LANES, by default 2), the two lanes of about the
- * same length.
+ * planet's levels of detail, then the planet's 3D Tiles in CesiumJS and in the viewer's 3D Tiles
+ * mode, each with servers of their own: in a browser of their own beside the others
+ * (PMC_E2E_LANES, by default 2), the two lanes of about the same length.
  */
-const SECOND_LANE = [lodEarth, elevationModel, lodDefault, cesiumTiles];
+const SECOND_LANE = [lodEarth, elevationModel, lodDefault, cesiumTiles, tilesMode];
 /** The steps whose pictures with back faces flagged are drawn by FLIGHTS_GL (harness.mjs). */
 const FLIGHTS = new Set([lodEarth, elevationModel, lodDefault]);
 /** Then, alone on the machine (it compares the times of its views): the soak. */

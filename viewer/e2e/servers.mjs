@@ -81,11 +81,14 @@ export async function startPmcServe(layout, { world = null, extra = [], port = 0
 
 const MIME = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.css': 'text/css', '.png': 'image/png', '.svg': 'image/svg+xml', '.json': 'application/json' };
 
-/** Serves viewer/dist and passes /api/ on to `apiBase`: tests the fresh viewer against the real API. */
+/**
+ * Serves viewer/dist and passes /api/ and /tiles/ (the 3D Tiles mode's tilesets) on to `apiBase`:
+ * tests the fresh viewer against the real API.
+ */
 export async function startFront(apiBase) {
   const api = new URL(apiBase);
   const server = createServer((req, res) => {
-    if (req.url.startsWith('/api/')) {
+    if (req.url.startsWith('/api/') || req.url.startsWith('/tiles/')) {
       const upstream = httpRequest(
         { host: api.hostname, port: api.port, path: req.url, method: req.method, headers: { ...req.headers, host: api.host } },
         (up) => {

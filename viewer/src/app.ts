@@ -3,7 +3,7 @@
 // editing and navigation state lives here; the work of a frame is frameLoop.ts's.
 
 import * as THREE from 'three';
-import { PmcApi, type PlanetInfo } from './api';
+import { PmcApi, type PlanetInfo, type TerrainInfo } from './api';
 import { storeAtmosphere, type SkySettings, type SkyState } from './atmosphere';
 import { atmosphereOf } from './atmosphereModel';
 import type { CameraMode } from './cameraModel';
@@ -41,6 +41,8 @@ import {
   type PmcStats,
   type TestHookTarget,
 } from './testHook';
+import { TILESET_PATH, noTiles, otherPlanet, type TilesStats } from './tiles';
+import type { TilesView } from './tilesMode';
 import { ToolsUi } from './toolsUi';
 import { Ui, formatDistance } from './ui';
 import { formatHash, parseHash, type UrlState } from './urlState';
@@ -74,6 +76,14 @@ export class App implements TestHookTarget {
   private readonly editor: EditSession;
   private editChanged = true;
   private readonly input: Input;
+  /** The 3D Tiles mode is on. */
+  private tilesOn = false;
+  /** Its tiles, drawn instead of the chunks; null when the mode is off or its renderer's code loads. */
+  private tiles: TilesView | null = null;
+  /** Changes to what the 3D Tiles mode draws (turned on or off, tiles shown or hidden), for the picture's key. */
+  private tilesPicture = 0;
+  /** What the planet shown is made of (`/planet`'s `terrain`), to tell whether the tiles show it. */
+  private terrain: TerrainInfo | null = null;
 
   private params: PlanetParams | null = null;
   private choice: { preset?: string; seed?: string } = {};
@@ -124,7 +134,8 @@ export class App implements TestHookTarget {
     });
     this.api.observer = this.connection;
     this.renderer.outputColorSpace = THREE.SRGBColorSpace;
-    this.cameras = new CameraController(canvas, () => this.scene.terrainMeshes());
+    // the ground the camera measures and picks: the chunks, or the tiles in the 3D Tiles mode
+    this.cameras = new CameraController(canvas, () => (this.tiles ? this.tiles.meshes() : this.scene.terrainMeshes()));
 
     this.streamer = new ChunkStreamer(this.api, {
       onShow: (name, seams, chunk) => {
@@ -156,6 +167,7 @@ export class App implements TestHookTarget {
       onWalk: (walk) => this.setWalk(walk),
       onDebug: (flags) => this.setDebug(flags),
       onNavGrid: (on) => this.setNavGrid(on),
+      onTiles: (on) => this.setTilesMode(on),
       onLod: (settings) => this.setLod(settings),
       onSky: (settings) => void this.setSky(settings),
       onBookmarkAdd: () => this.addBookmark(),
@@ -245,7 +257,8 @@ export class App implements TestHookTarget {
         },
         panels: (planetShown) => this.panels(planetShown),
         moved: () => this.writeHash(false),
-        pictureChanges: () => this.navScene.pictureChanges(),
+        pictureChanges: () => this.navScene.pictureChanges() + this.tilesPicture,
+        tiles: () => (this.tilesOn ? { view: this.tiles } : null),
       },
     );
 
@@ -342,6 +355,8 @@ export class App implements TestHookTarget {
     this.planetJson = planetIdentity(info);
     this.params = planetParams(info);
     this.planetTitle = planetName(info);
+    this.terrain = info.terrain ?? null;
+    if (this.tiles) this.checkTilesPlanet(this.tiles.stats(performance.now()).terrain);
     document.title = `${this.planetTitle} — PMC`;
     // An elevation-model planet has no preset: it is the server's own planet, asked for with
     // no preset parameter (the picker lists it under the empty value).
@@ -530,6 +545,7 @@ export class App implements TestHookTarget {
       this.ui.setLod(this.selection.settings);
       this.readiness.reset();
     }
+    if (u.tiles !== undefined) this.setTilesMode(u.tiles, false);
     if (fromUser) this.ui.setMode(this.cameras.mode, this.cameras.walk);
   }
 
@@ -558,6 +574,7 @@ export class App implements TestHookTarget {
       ...(lod.maxPixelError !== DEFAULT_LOD.maxPixelError ? { px: lod.maxPixelError } : {}),
       ...(lod.maxChunks !== DEFAULT_LOD.maxChunks ? { chunks: lod.maxChunks } : {}),
       ...(this.antialias ? {} : { aa: false }),
+      ...(this.tilesOn ? { tiles: true } : {}),
     });
   }
 
@@ -626,6 +643,9 @@ export class App implements TestHookTarget {
         return true;
       case 'north':
         if (!e.repeat) this.faceNorth();
+        return true;
+      case 'tiles':
+        if (!e.repeat) this.setTilesMode(!this.tilesOn);
         return true;
       default:
         // the camera's keys (input.ts)
@@ -781,6 +801,60 @@ export class App implements TestHookTarget {
     this.loop.invalidate();
   }
 
+  // ---- 3D Tiles mode ----------------------------------------------------------------------------
+
+  /**
+   * The 3D Tiles mode on or off (the panel's button, `T`, `#tiles=1`, the test hook). On: the
+   * chunks are hidden and no chunk is asked for; a TilesRenderer (tilesMode.ts, its code loaded
+   * the first time) loads the server's tileset in the sphere frame and draws it in their place.
+   * Off: the tiles are disposed and the chunks show again (those loaded before at once; the view's
+   * selection resumes).
+   */
+  setTilesMode(on: boolean, writeHash = true): void {
+    if (on === this.tilesOn) return;
+    this.tilesOn = on;
+    if (on) {
+      import('./tilesMode')
+        .then(({ TilesView }) => {
+          if (!this.tilesOn || this.tiles) return;
+          this.tiles = new TilesView(new URL(TILESET_PATH, document.baseURI).href, this.scene.scene, this.scene.waterUniforms(), {
+            onChange: () => {
+              this.tilesPicture++;
+              this.cameras.groundChanged();
+            },
+            onError: (message) => this.showError(message),
+            onTileset: (frame, terrain) => {
+              if (frame !== 'sphere') this.showError(`3D Tiles: the tileset is in the ${String(frame)} frame, not on the planet's sphere as drawn here`);
+              else this.checkTilesPlanet(terrain);
+            },
+          });
+          this.tilesPicture++;
+          this.cameras.groundChanged();
+        })
+        .catch((e: unknown) => this.showError(`3D Tiles: cannot load the tiles' renderer: ${e instanceof Error ? e.message : String(e)}`));
+    } else {
+      this.tiles?.dispose();
+      this.tiles = null;
+    }
+    this.tilesPicture++;
+    this.scene.setChunksVisible(!on);
+    this.cameras.groundChanged();
+    this.readiness.reset();
+    this.ui.setTilesMode(on);
+    if (writeHash) this.writeHash(true);
+  }
+
+  tilesStats(): TilesStats {
+    return this.tiles?.stats(performance.now()) ?? noTiles(this.tilesOn);
+  }
+
+  /** The tiles are of the planet the server serves: say so when another one is shown here. */
+  private checkTilesPlanet(terrain: string | null): void {
+    if (otherPlanet(terrain, this.terrain)) {
+      this.showError(`3D Tiles show the planet the server serves (${String(terrain)}), not the one chosen here`);
+    }
+  }
+
   // ---- panels -------------------------------------------------------------------------------
 
   private resize(): void {
@@ -886,6 +960,7 @@ export class App implements TestHookTarget {
       cursor: this.scene.brushCursorVisible(),
       edit: this.editor.status(),
       pathTool: this.pathActive,
+      tiles: this.tilesStats(),
     };
   }
 }

@@ -1,19 +1,22 @@
 // The frame loop: every animation frame moves the camera by the input and places the scene around
 // it (the floating origin), runs the brush and the navigation overlay, sets the sky and the sun,
-// asks for the level-of-detail selection of the view and streams its chunks, renders, counts the
-// settled frames `__pmc.ready()` waits for and refreshes the panels.
+// asks for the level-of-detail selection of the view and streams its chunks (or, in the 3D Tiles
+// mode, lets the tiles pick and load theirs), renders, counts the settled frames `__pmc.ready()`
+// waits for and refreshes the panels.
 
 import * as THREE from 'three';
 import { FOV, type CameraController } from './cameraController';
 import { metresPerPixel, rayToSphere, scaleBar } from './hud';
 import { formatLevels } from './chunkSelection';
 import type { ChunkStreamer } from './chunkStreamer';
-import { length, type V3 } from './frames';
+import { length, normalize, type V3 } from './frames';
 import type { Input, InputFrame } from './input';
 import type { PlanetParams } from './planetParams';
 import { PictureKey } from './pictureKey';
 import type { PlanetScene } from './planetScene';
 import type { Readiness } from './readiness';
+import { noTiles } from './tiles';
+import type { TilesView } from './tilesMode';
 import type { Ui } from './ui';
 import type { ViewSelection } from './viewSelection';
 
@@ -49,8 +52,13 @@ export interface FrameSteps {
   panels(planetShown: boolean): void;
   /** The camera moved this frame. */
   moved(): void;
-  /** Changes to the objects the application draws besides the scene's (the navigation overlay). */
+  /** Changes to the objects the application draws besides the scene's (the navigation overlay, the tiles). */
   pictureChanges(): number;
+  /**
+   * The 3D Tiles mode: null when off; on, its tiles (`view`), drawn instead of the chunks (null
+   * for the moment its renderer's code loads).
+   */
+  tiles(): { view: TilesView | null } | null;
 }
 
 export class FrameLoop {
@@ -154,8 +162,11 @@ export class FrameLoop {
     }
     const shape = params.shape;
     const flying = steps.travel(now);
+    const tilesMode = steps.tiles();
+    const tiles = tilesMode?.view ?? null;
     const { pos, basis, moved } = cameras.frame(input, params, dt, this.frames, (p) => {
       scene.place(p);
+      tiles?.place(p);
       scene.scene.updateMatrixWorld();
     });
     steps.brush(input);
@@ -172,18 +183,24 @@ export class FrameLoop {
     // (by default south-east-ish and well up); the atmosphere's place of the camera
     scene.setSun(scene.atmosphere.frame(pos));
 
-    // streaming: select for this view (when it changed), fetch and show
-    const viewportHeightPx = renderer.getDrawingBufferSize(new THREE.Vector2()).y;
-    selection.frame(cameras.camera, viewportHeightPx, pos, basis.forward, basis.up, now, steps.busy() !== null);
-    streamer.update();
+    // streaming: select for this view (when it changed), fetch and show; in the 3D Tiles mode no
+    // chunk is asked for (those loaded stay, hidden), the tiles select theirs at the same
+    // screen-space error and load them
+    if (tilesMode) {
+      tiles?.update(cameras.camera, renderer, selection.settings.maxPixelError, scene.sunDirection(), normalize(pos), now);
+    } else {
+      const viewportHeightPx = renderer.getDrawingBufferSize(new THREE.Vector2()).y;
+      selection.frame(cameras.camera, viewportHeightPx, pos, basis.forward, basis.up, now, steps.busy() !== null);
+      streamer.update();
+    }
 
-    const settled = streamer.settled();
+    const settled = tilesMode ? (tiles?.settled(now) ?? false) : streamer.settled();
     const changed = this.pictureKey.changed(this.frameKey(pos));
     if (this.redraw.shouldDraw(now, moved || inputActive(input), settled, changed, this.gpu.busy)) this.draw(now);
 
     const st = streamer.stats();
     const wasReady = readiness.ready;
-    readiness.frame(!flying && steps.busy() === null && selection.current() && settled);
+    readiness.frame(!flying && steps.busy() === null && (tilesMode !== null || selection.current()) && settled);
     // the panels every 200 ms, and in the frame the view becomes ready: what they say then is
     // what is shown (a waiter of `__pmc.ready()` reads them after this frame)
     if (now - this.lastUiUpdate > 200 || (readiness.ready && !wasReady)) {
@@ -209,7 +226,10 @@ export class FrameLoop {
         heading: s.heading,
         scale,
       });
-      ui.setLoading(st.shown, st.pending, st.missing, steps.busy());
+      const ts = tilesMode ? (tiles?.stats(now) ?? noTiles(true)) : null;
+      ui.setTiles(ts);
+      if (ts) ui.setLoading(ts.visible, ts.queued + ts.downloading + ts.parsing, 0, steps.busy());
+      else ui.setLoading(st.shown, st.pending, st.missing, steps.busy());
       steps.editStats();
     }
     steps.panels(true);

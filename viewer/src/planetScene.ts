@@ -28,7 +28,7 @@ export const FACE_COLOURS: [number, number, number][] = [
 ];
 
 /** The stencil value every terrain pixel writes; the sea disk draws only where it is not. */
-const TERRAIN_STENCIL = 1;
+export const TERRAIN_STENCIL = 1;
 
 export const SKY_COLOUR = new THREE.Color(0.52, 0.66, 0.85); // linear, for aerial perspective
 /** Background near the ground (a clear sky) and far out (space), linear RGB. */
@@ -65,6 +65,28 @@ export interface DebugFlags {
   lighting: boolean;
   /** The sea: water where the ground is below the datum, and the sea disk (off, test mode: neither). */
   sea: boolean;
+}
+
+/**
+ * The terrain's uniforms of its water (`PlanetScene.waterUniforms`): the objects the terrain's
+ * materials share, for the sea's surface (shaders.ts `SEA_SURFACE`) over ground under the sea.
+ */
+export interface WaterUniforms {
+  /** 1: water drawn over ground under the sea; 0: not (test mode). */
+  uWater: { value: number };
+  /** Linear RGB: the light the water keeps in the shallows, and the colour of deep water. */
+  uWaterShallow: { value: THREE.Vector3 };
+  uWaterDeep: { value: THREE.Vector3 };
+  /** Metres of water that absorb most light. */
+  uWaterScale: { value: number };
+  /** The sea surface's colour and the sky's it reflects (linear RGB), the sun (planet frame, unit). */
+  uSeaColour: { value: THREE.Vector3 };
+  uSkyColour: { value: THREE.Vector3 };
+  uSunDir: { value: THREE.Vector3 };
+  /** The eye's place, planet frame (its f32 part: for directions). */
+  uEyeHigh: { value: THREE.Vector3 };
+  /** 1: lit; 0: the test mode without lighting. */
+  uLighting: { value: number };
 }
 
 /** A vertex of a chunk shown (`PlanetScene.sampleVertices`). */
@@ -532,6 +554,42 @@ export class PlanetScene {
     }
     const rel = relativeToCamera(this.seaDisk.origin, camera);
     this.sea.position.set(rel[0], rel[1], rel[2]);
+  }
+
+  /**
+   * Draws the chunks, or not (the 3D Tiles mode draws the planet from its tiles instead); hidden,
+   * they stay in the scene, and the streamer keeps what it loaded for when they show again.
+   */
+  setChunksVisible(visible: boolean): void {
+    if (this.terrainGroup.visible === visible) return;
+    this.terrainGroup.visible = visible;
+    this.changes++;
+  }
+
+  /**
+   * The terrain's uniforms of its water (on or off, its colours, the depth that absorbs most
+   * light, the sea's surface): the 3D Tiles mode draws the water over the tiles' ground under the
+   * sea with them, as the terrain does.
+   */
+  waterUniforms(): WaterUniforms {
+    const s = this.shared;
+    return {
+      uWater: s.uWater,
+      uWaterShallow: s.uWaterShallow,
+      uWaterDeep: s.uWaterDeep,
+      uWaterScale: s.uWaterScale,
+      uSeaColour: s.uSeaColour,
+      uSkyColour: s.uSkyColour,
+      uSunDir: s.uSunDir,
+      uEyeHigh: s.uEyeHigh,
+      uLighting: s.uLighting,
+    };
+  }
+
+  /** The sun's direction (planet frame, unit), as the last `setSun` set it. */
+  sunDirection(): V3 {
+    const d = this.shared.uSunDir.value;
+    return [d.x, d.y, d.z];
   }
 
   /** Chunk meshes for raycasting (walk mode). */

@@ -79,9 +79,10 @@ export const JITTER_SCALE = 0.25;
  * `v` (toward the eye): the surface's colour and sky reflection (Fresnel) and the sun's glint,
  * blended over `below` by the surface's opacity (nearly clear looking down, opaque at grazing
  * angles), which is returned in `.a`. The terrain shader draws it over ground below the datum, the
- * sea disk where no ground lies behind the surface, so both look the same.
+ * sea disk where no ground lies behind the surface, so both look the same (and so do the tiles of
+ * the 3D Tiles mode: tilesMode.ts).
  */
-const SEA_SURFACE = /* glsl */ `
+export const SEA_SURFACE = /* glsl */ `
 vec4 pmcSeaSurface(vec3 below, vec3 n, vec3 v) {
   float cosV = clamp(dot(n, v), 0.0, 1.0);
   float fresnel = 0.02 + 0.98 * pow(1.0 - cosV, 5.0);

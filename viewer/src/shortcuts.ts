@@ -27,6 +27,7 @@ export type ShortcutAction =
   | 'panel'
   | 'goto'
   | 'north'
+  | 'tiles'
   | 'help';
 
 /** The help's sections, in order. */
@@ -86,6 +87,7 @@ export const SHORTCUTS: readonly Shortcut[] = [
   { action: 'overlays', codes: ['KeyH'], shift: false, keys: 'H', what: 'hide / show every overlay (the planet alone)', group: 'View' },
   { action: 'panel', codes: ['KeyP'], shift: false, keys: 'P', what: 'open / close the side panel (statistics, planet, detail, debug, sky)', group: 'View' },
   { action: 'goto', codes: [], char: '/', keys: '/', what: 'type a place in the go-to box', group: 'View' },
+  { action: 'tiles', codes: ['KeyT'], shift: false, keys: 'T', what: "3D Tiles mode on / off: the planet from the server's 3D Tiles instead of its chunks", group: 'View' },
   { action: 'north', codes: ['KeyR'], shift: false, keys: 'R', what: 'face north (as clicking the compass does)', group: 'Camera' },
   { action: 'help', codes: [], char: '?', keys: '?', what: 'this help', group: 'View' },
 ];

@@ -12,6 +12,7 @@ import type { NavGridStatus, NavOverlayData } from './navOverlay';
 import type { PathStatus } from './pathTool';
 import type { DebugFlags, SampledVertex } from './planetScene';
 import type { Readiness } from './readiness';
+import type { TilesStats } from './tiles';
 import type { LodSettings } from './viewSelection';
 
 export type ModeName = CameraMode | 'walk';
@@ -81,6 +82,12 @@ export interface PmcStats {
   edit: EditStatus;
   /** The Path tool is chosen (the left button picks the path's ends). */
   pathTool: boolean;
+  /**
+   * The 3D Tiles mode: whether it is on, and its tiles (loaded, drawn, queued, downloading,
+   * parsing, failed; `settled` once nothing was loading for a while). With the mode on, the
+   * chunks are not drawn and none is asked for (the chunk counts above are those kept).
+   */
+  tiles: TilesStats;
 }
 
 /** `__pmc.places()`: a vertex of a chunk shown and where it shows on the canvas. */
@@ -163,6 +170,12 @@ export interface PmcTestHook {
    * only when the picture changes): a still camera's next picture, drawn anew.
    */
   redraw(): void;
+  /**
+   * Turns the 3D Tiles mode on or off when `on` is given; returns its state (`stats().tiles`).
+   * With the mode on, `ready()` waits for the tiles to settle (nothing queued, downloading or
+   * parsing for a while) instead of the chunks.
+   */
+  tiles(on?: boolean): TilesStats;
 }
 
 declare global {
@@ -195,6 +208,10 @@ export interface TestHookTarget {
   lodSettings(): LodSettings;
   /** The next frame draws, whatever its picture's key. */
   invalidate(): void;
+  /** The 3D Tiles mode on or off. */
+  setTilesMode(on: boolean): void;
+  /** The 3D Tiles mode's state. */
+  tilesStats(): TilesStats;
 }
 
 export function createTestHook(app: TestHookTarget): PmcTestHook {
@@ -236,6 +253,10 @@ export function createTestHook(app: TestHookTarget): PmcTestHook {
       return { ...app.lodSettings() };
     },
     redraw: () => app.invalidate(),
+    tiles: (on) => {
+      if (on !== undefined) app.setTilesMode(on);
+      return app.tilesStats();
+    },
   };
 }
 

@@ -8,6 +8,7 @@ import type { CameraMode } from './cameraModel';
 import type { PresetInfo } from './api';
 import type { DebugFlags } from './planetScene';
 import type { NavGridStatus } from './navOverlay';
+import type { TilesStats } from './tiles';
 import { MOUSE_HELP, SHORTCUTS, SHORTCUT_GROUPS } from './shortcuts';
 import { formatLat, formatLon, loadingShare, type ScaleBar } from './hud';
 import { PANEL_SECTIONS, loadPanelState, savePanelState, type PanelSection, type PanelState, type StorageLike } from './panelState';
@@ -19,6 +20,8 @@ export interface UiCallbacks {
   onDebug(flags: Partial<DebugFlags>): void;
   /** The nav grid checkbox. */
   onNavGrid(on: boolean): void;
+  /** The 3D Tiles button: the planet from the server's 3D Tiles (on) or its chunks (off). */
+  onTiles(on: boolean): void;
   /** The detail fields: largest screen-space error in pixels, chunk budget. */
   onLod(settings: { maxPixelError?: number; maxChunks?: number }): void;
   /** The sky fields: the atmosphere checkbox, the sun's elevation and azimuth (degrees). */
@@ -77,6 +80,9 @@ export class Ui {
   private readonly seed = byId<HTMLInputElement>('seed');
   private readonly modeButton = byId<HTMLButtonElement>('mode');
   private readonly walk = byId<HTMLInputElement>('walk');
+  private readonly tilesButton = byId<HTMLButtonElement>('tiles');
+  private tilesOn = false;
+  private shownTiles = '';
   private readonly wireframe = byId<HTMLInputElement>('wireframe');
   private readonly faces = byId<HTMLInputElement>('faces');
   private readonly borders = byId<HTMLInputElement>('borders');
@@ -114,6 +120,7 @@ export class Ui {
     alt: byId('hud-alt'),
     ground: byId('hud-ground'),
     heading: byId('hud-heading'),
+    tiles: byId('hud-tiles'),
     needle: document.getElementById('compass-needle') as Element | null,
     scale: byId('scale'),
     scaleBar: byId('scale-bar'),
@@ -194,6 +201,10 @@ export class Ui {
       this.callbacks.onMode(this.mode === 'orbit' ? 'fly' : 'orbit');
     });
     this.walk.addEventListener('change', () => this.callbacks.onWalk(this.walk.checked));
+    this.tilesButton.addEventListener('click', () => {
+      this.callbacks.onTiles(!this.tilesOn);
+      this.tilesButton.blur();
+    });
     this.wireframe.addEventListener('change', () =>
       this.callbacks.onDebug({ wireframe: this.wireframe.checked }),
     );
@@ -264,6 +275,26 @@ export class Ui {
     this.modeButton.textContent = `Mode: ${mode}`;
     this.walk.checked = walk;
     this.walk.disabled = mode !== 'fly';
+  }
+
+  /** The 3D Tiles button, and the HUD's line of the mode (hidden when off). */
+  setTilesMode(on: boolean): void {
+    this.tilesOn = on;
+    this.tilesButton.textContent = `3D Tiles: ${on ? 'on' : 'off'}`;
+    this.tilesButton.setAttribute('aria-pressed', String(on));
+    if (!on) this.setTiles(null);
+  }
+
+  /** The HUD's line of the 3D Tiles mode: tiles drawn, loaded and loading; null hides it. */
+  setTiles(s: TilesStats | null): void {
+    const loading = s ? s.queued + s.downloading + s.parsing : 0;
+    const text = s
+      ? `3D Tiles · ${fmtInt(s.visible)} drawn · ${fmtInt(s.loaded)} loaded${loading > 0 ? ` · ${fmtInt(loading)} loading` : ''}${s.failed > 0 ? ` · ${fmtInt(s.failed)} failed` : ''}`
+      : '';
+    if (text === this.shownTiles) return;
+    this.shownTiles = text;
+    this.hud.tiles.hidden = s === null;
+    this.hud.tiles.textContent = text;
   }
 
   setDebug(flags: DebugFlags): void {

@@ -1,6 +1,7 @@
 // The viewer's state in the URL hash, e.g.
 // `#preset=earthlike&seed=7&mode=orbit&lat=12.5&lon=-40&alt=3000&heading=0&pitch=-90`, and the
-// detail settings when they are not the defaults (`&px=1&chunks=4000`).
+// detail settings when they are not the defaults (`&px=1&chunks=4000`), and the 3D Tiles mode when
+// it is on (`&tiles=1`).
 // Pure: parse and format only.
 
 import type { CameraMode } from './cameraModel';
@@ -20,6 +21,8 @@ export interface UrlState {
   chunks?: number;
   /** Antialiasing (multisampling) off when false; on when absent. */
   aa?: boolean;
+  /** The 3D Tiles mode: the planet from the server's 3D Tiles (true) or its chunks (false). */
+  tiles?: boolean;
 }
 
 const NUMBER_KEYS = ['lat', 'lon', 'alt', 'heading', 'pitch'] as const;
@@ -49,6 +52,9 @@ export function parseHash(hash: string): UrlState {
   const aa = params.get('aa');
   if (aa === '0' || aa === 'false' || aa === 'off') out.aa = false;
   else if (aa === '1' || aa === 'true' || aa === 'on') out.aa = true;
+  const tiles = params.get('tiles');
+  if (tiles === '0' || tiles === 'false' || tiles === 'off') out.tiles = false;
+  else if (tiles === '1' || tiles === 'true' || tiles === 'on') out.tiles = true;
   return out;
 }
 
@@ -71,5 +77,6 @@ export function formatHash(s: UrlState): string {
   if (s.px !== undefined) params.set('px', fmt(s.px, 2));
   if (s.chunks !== undefined) params.set('chunks', String(Math.round(s.chunks)));
   if (s.aa === false) params.set('aa', '0');
+  if (s.tiles) params.set('tiles', '1');
   return `#${params.toString()}`;
 }

@@ -34,6 +34,8 @@ describe('the shortcut table', () => {
     expect(shortcutOf(press('KeyN'))?.action).toBe('navgrid');
     expect(shortcutOf(press('KeyN', { shiftKey: true }))).toBeNull();
     expect(shortcutOf(press('KeyH'))?.action).toBe('overlays');
+    expect(shortcutOf(press('KeyT'))?.action).toBe('tiles');
+    expect(shortcutOf(press('KeyT', { shiftKey: true }))).toBeNull();
     expect(shortcutOf(press('Slash', { key: '?', shiftKey: true }))?.action).toBe('help');
     // '?' wherever a layout puts it
     expect(shortcutOf(press('Minus', { key: '?', shiftKey: true }))?.action).toBe('help');

@@ -44,3 +44,16 @@ describe('antialiasing in the URL', () => {
     expect(parseHash('#lat=1').aa).toBeUndefined();
   });
 });
+
+describe('the 3D Tiles mode in the URL', () => {
+  it('is kept in the link only when on, and read in a few spellings', () => {
+    expect(formatHash({ preset: 'earth' })).not.toContain('tiles=');
+    expect(formatHash({ preset: 'earth', tiles: false })).not.toContain('tiles=');
+    const on = formatHash({ preset: 'earth', tiles: true });
+    expect(on).toContain('tiles=1');
+    expect(parseHash(on).tiles).toBe(true);
+    for (const v of ['1', 'true', 'on']) expect(parseHash(`#tiles=${v}`).tiles).toBe(true);
+    for (const v of ['0', 'false', 'off']) expect(parseHash(`#tiles=${v}`).tiles).toBe(false);
+    expect(parseHash('#tiles=maybe').tiles).toBeUndefined();
+  });
+});

@@ -2,16 +2,19 @@
 // the example page (examples/cesium, served at /cesium/) loads them with no console error, and
 // with the terrain's back faces drawn magenta no view shows one, over the earth preset and over
 // an imported elevation model, from orbit down to 2 m: CesiumJS picks each tile's level on its
-// own, and the closed tiles leave no crack into a solid.
+// own, and the closed tiles leave no crack into a solid. An edit through the API shows in
+// CesiumJS once it fetches the tileset again (the pit is there), and a tileset baked by
+// `pmc tiles bake`, hosted by a plain static file server, loads and shows no crack either.
 
-import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { createReadStream, existsSync, mkdtempSync, rmSync, statSync, writeFileSync } from 'node:fs';
+import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { join, normalize, resolve, sep } from 'node:path';
 import { DEM_SOURCE, PMC_BIN, artifacts, check, cleanups, log, run, viewerDir } from '../harness.mjs';
 import { decodePng } from '../images.mjs';
 import { startPmcServe } from '../servers.mjs';
 
-export const name = '19. the planet in CesiumJS from pmc serve\'s 3D Tiles: no console error, and no crack showing a back face (magenta) in any view from orbit to 2 m, over the earth preset and an elevation model';
+export const name = '19. the planet in CesiumJS from pmc serve\'s 3D Tiles: no console error, and no crack showing a back face (magenta) in any view from orbit to 2 m, over the earth preset, an elevation model and a baked tileset on a static server; an edit shows as a pit';
 
 /** CesiumJS's build, installed by `npm ci` in examples/cesium (scripts/test.sh does it). */
 export const CESIUM_JS = resolve(viewerDir, '../examples/cesium/node_modules/cesium/Build/Cesium');
@@ -60,12 +63,16 @@ function countPixels(png) {
   return { magenta, isolated, cyan, terrain, total: width * height };
 }
 
-/** The views of one planet: from orbit, then 10 km, 100 m and 2 m over the ground at a place. */
-async function views(t, label, server, lat, lon) {
+/**
+ * The views of one planet: from orbit, then 10 km, 100 m and 2 m over the ground at a place (or
+ * the heights given). `tiles` is the tileset's URL (default: the server's own).
+ */
+async function views(t, label, server, lat, lon, { tiles = null, heights = [10_000, 100, 2] } = {}) {
   const { page } = t;
   // (a screen-space error of 4 pixels: the levels CesiumJS mixes are as unbalanced as at 2, with
   // a quarter of the tiles to load)
-  const url = `${server.base}cesium/?flag=1&sse=4&lat=${lat}&lon=${lon}&height=12000000&pitch=-90`;
+  const from = tiles ? `tiles=${encodeURIComponent(tiles)}&` : '';
+  const url = `${server.base}cesium/?${from}flag=1&sse=4&lat=${lat}&lon=${lon}&height=12000000&pitch=-90`;
   await page.goto(url, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmcCesium !== undefined, null, { timeout: 60_000 });
   const frame = await page.evaluate(() => window.__pmcCesium.info.frame);
@@ -125,11 +132,10 @@ async function views(t, label, server, lat, lon) {
   const ground = await page.evaluate(([la, lo]) => window.__pmcCesium.groundHeight(la, lo), [lat, lon]);
   check(Number.isFinite(ground), `no ground under ${lat}, ${lon}: ${ground}`);
   log(`  ${label}: the ground under ${lat}, ${lon} is ${ground.toFixed(1)} m above the datum`);
-  for (const [view, h, pitch] of [
-    ['10km', 10_000, -45],
-    ['100m', 100, -20],
-    ['2m', 2, -12],
-  ]) {
+  if (label === 'earth') t.shared.cesiumGround = ground;
+  const pitches = { 10000: -45, 100: -20, 2: -12 };
+  for (const h of heights) {
+    const [view, pitch] = [h >= 1000 ? `${h / 1000}km` : `${h}m`, pitches[h] ?? -45];
     await page.evaluate(([la, lo, hh, p]) => window.__pmcCesium.setView({ lat: la, lon: lo, height: hh, heading: 30, pitch: p }), [lat, lon, ground + h, pitch]);
     await look(view, `${h} m over the ground`);
   }
@@ -158,11 +164,82 @@ async function asSeen(t, server) {
   check(share > 0.1, `the planet as seen in CesiumJS has colour on ${(100 * share).toFixed(1)}% of the view; see ${file}`);
 }
 
+/**
+ * An edit through the API, then CesiumJS fetching the tileset again: the ground under the place
+ * is lower by most of the brush's radius (the pit is there).
+ */
+async function pit(t, server, lat, lon) {
+  const { page } = t;
+  // Looking straight down from 5 km over the place: the ground under it as drawn (tiles of about
+  // 10 m voxels there, at a screen-space error of 4).
+  const drawnGround = async (heading) => {
+    await page.goto(`${server.base}cesium/?sse=4&lat=${lat}&lon=${lon}&height=${ground0 + 5000}&pitch=-90&heading=${heading}`, { waitUntil: 'load', timeout: 60_000 });
+    await page.waitForFunction(() => window.__pmcCesium !== undefined, null, { timeout: 60_000 });
+    await page.evaluate(() => window.__pmcCesium.loaded());
+    return page.evaluate(([la, lo]) => window.__pmcCesium.groundHeight(la, lo, { drawn: true }), [lat, lon]);
+  };
+  const ground0 = t.shared.cesiumGround;
+  const before = await drawnGround(0);
+  const { datumRadius, revision } = await page.evaluate(() => window.__pmcCesium.info);
+  check(Number.isFinite(before), `no ground drawn under ${lat}, ${lon}: ${before}`);
+  // The place in the planet's frame (http-api-v1.md: Y to the north pole, longitude 0 on +Z); in
+  // the WGS84 frame a tile's height above the ellipsoid is the terrain's height above the datum.
+  const [a, b] = [(lat * Math.PI) / 180, (lon * Math.PI) / 180];
+  const r = datumRadius + before;
+  const radius = 60;
+  const edit = { brush: 'remove', x: r * Math.cos(a) * Math.sin(b), y: r * Math.sin(a), z: r * Math.cos(a) * Math.cos(b), radius };
+  const answer = await fetch(`${server.base}api/v1/edits`, { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(edit) });
+  check(answer.ok, `the edit was refused: ${answer.status} ${await answer.text()}`);
+  // The page fetches tileset.json again (as a reload does): new URLs, the planet as edited.
+  const after = await drawnGround(1);
+  const revisionAfter = await page.evaluate(() => window.__pmcCesium.info.revision);
+  const file = join(artifacts, 'cesium-earth-pit.png');
+  writeFileSync(file, await page.screenshot({ type: 'png' }));
+  log(`  the pit: a remove of radius ${radius} m at ${lat}, ${lon}; the ground there drawn at ${before.toFixed(1)} m before, ${after.toFixed(1)} m after (revision ${revision} -> ${revisionAfter}); see ${file}`);
+  check(revisionAfter === revision + 1, `the tileset's revision went from ${revision} to ${revisionAfter} after one edit`);
+  check(after < before - 0.5 * radius, `CesiumJS draws the ground at ${after} m after the edit, ${before} m before: no pit of radius ${radius} m`);
+}
+
+/** A static file server for `dir` (what any web host does), with CORS for the page's origin. */
+async function serveFolder(dir) {
+  const root = resolve(dir);
+  const server = createServer((req, res) => {
+    const path = normalize(join(root, decodeURIComponent(new URL(req.url, 'http://x').pathname)));
+    if (!path.startsWith(root + sep) || !existsSync(path) || !statSync(path).isFile()) {
+      res.writeHead(404, { 'access-control-allow-origin': '*' }).end('not found');
+      return;
+    }
+    const type = path.endsWith('.json') ? 'application/json' : 'model/gltf-binary';
+    res.writeHead(200, { 'content-type': type, 'access-control-allow-origin': '*' });
+    createReadStream(path).pipe(res);
+  });
+  await new Promise((r) => server.listen(0, '127.0.0.1', r));
+  cleanups.push(() => server.close());
+  return `http://127.0.0.1:${server.address().port}/`;
+}
+
+/** A region of the earth preset baked by `pmc tiles bake`, hosted as plain files: no crack. */
+async function baked(t, earth) {
+  const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-bake-'));
+  cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
+  const out = join(dir, 'tiles');
+  const args = ['tiles', 'bake', '--quiet', '--preset', 'earth', '--region', '39,0,20000', '--max-level', '11', '-o', out];
+  const bake = await run(PMC_BIN, args, 300_000);
+  check(bake.code === 0, `pmc ${args.join(' ')} failed: ${bake.out}`);
+  const url = `${await serveFolder(out)}tileset.json`;
+  log(`  baked: pmc ${args.join(' ')}, hosted at ${url}`);
+  await views(t, 'baked', earth, 39, 0, { tiles: url, heights: [10_000] });
+}
+
 export async function scenario(t) {
   check(existsSync(join(CESIUM_JS, 'Cesium.js')), `no CesiumJS at ${CESIUM_JS}: run npm ci in examples/cesium`);
-  const earth = await startPmcServe(null, { extra: ['--preset', 'earth', '--cesium-js', CESIUM_JS] });
+  const worldDir = mkdtempSync(join(tmpdir(), 'pmc-e2e-cesium-world-'));
+  cleanups.push(() => rmSync(worldDir, { recursive: true, force: true }));
+  const earth = await startPmcServe(null, { world: join(worldDir, 'earth.pmcw'), extra: ['--preset', 'earth', '--cesium-js', CESIUM_JS] });
   await asSeen(t, earth);
   await views(t, 'earth', earth, 39, 0);
+  await baked(t, earth);
+  await pit(t, earth, 39, 0);
   await earth.stop();
   // an elevation model (ETOPO5 where installed, as in step 11: the file it imported, or a new one)
   let dem = t.shared.dem;
