@@ -106,24 +106,32 @@ impl PartialEq for Rank {
 
 impl Eq for Rank {}
 
-/// Where a job stands.
-enum JobState {
-    /// Waiting in the queue at `rank`, with what the worker needs.
-    Queued {
-        rank: Rank,
+/// What a queued job does.
+enum Work {
+    /// Mesh and encode the job's chunk of `planet`, whose edits are those of `revision`, and
+    /// send the outcome on `tx`.
+    Chunk {
         planet: Arc<Planet>,
-        /// The edit revision of `planet`.
         revision: u64,
         tx: watch::Sender<Option<JobResult>>,
     },
-    /// A worker is generating it.
+    /// Run a task ([`Generator::task`]); it hands on its outcome itself.
+    Task(Box<dyn FnOnce() + Send>),
+}
+
+/// Where a job stands.
+enum JobState {
+    /// Waiting in the queue at `rank`, with what the worker needs.
+    Queued { rank: Rank, work: Work },
+    /// A worker is running it.
     Running,
 }
 
 /// A job: queued or running (a job leaves [`Store::jobs`] when it ends or is dropped).
 struct Job {
-    id: ChunkId,
-    /// The receiver its waiters share.
+    /// The chunk it makes (`None` for a task).
+    id: Option<ChunkId>,
+    /// The receiver its waiters share (a task's waiter waits on its own channel).
     rx: watch::Receiver<Option<JobResult>>,
     /// Requests waiting for it (each holds a [`Waiter`]).
     waiters: usize,
@@ -343,14 +351,12 @@ impl Generator {
                     store.jobs.insert(
                         token,
                         Job {
-                            id: id.clone(),
+                            id: Some(id.clone()),
                             rx: rx.clone(),
                             waiters: 1,
                             state: JobState::Queued {
                                 rank,
-                                planet,
-                                revision,
-                                tx,
+                                work: Work::Chunk { planet, revision, tx },
                             },
                         },
                     );
@@ -395,7 +401,9 @@ impl Generator {
         let id = job.id.clone();
         store.queue.remove(&rank);
         store.jobs.remove(&token);
-        store.unregister(id, token);
+        if let Some(id) = id {
+            store.unregister(id, token);
+        }
         store.counts.dropped += 1;
     }
 
@@ -446,11 +454,22 @@ impl Generator {
             };
             let (planet, revision, tx) = match std::mem::replace(&mut job.state, JobState::Running) {
                 JobState::Queued {
-                    planet, revision, tx, ..
+                    work: Work::Chunk { planet, revision, tx },
+                    ..
                 } => (planet, revision, tx),
+                JobState::Queued {
+                    work: Work::Task(task), ..
+                } => {
+                    store.counts.running += 1;
+                    drop(guard);
+                    self.run_task(token, task);
+                    return;
+                }
                 JobState::Running => return,
             };
-            let id = job.id.clone();
+            let Some(id) = job.id.clone() else {
+                return;
+            };
             // The mesh before the edit of this job's revision, when it is kept.
             let previous = store.meshes.as_ref().and_then(|r| {
                 r.previous
@@ -499,6 +518,67 @@ impl Generator {
             store.jobs.remove(&token);
         }
         tx.send_replace(Some(result));
+    }
+
+    /// Queues `task` among the chunk jobs, at `priority` (as [`Generator::chunk`]'s): it runs on
+    /// one of the same workers, in the same order, and counts in the same counters. Dropping the
+    /// returned future before a worker starts the task withdraws it (the task is dropped, never
+    /// run); once started it runs to its end. The task hands on what it makes itself (a channel,
+    /// a cache). Unlike a chunk it is never refused for a full queue: the clients of tasks (3D
+    /// Tiles viewers) do not ask again after a 503, they show a hole.
+    pub async fn task(self: &Arc<Self>, priority: f64, task: impl FnOnce() + Send + 'static) -> Result<(), ChunkError> {
+        let priority = priority + 0.0;
+        let (mut rx, token) = {
+            let mut store = self.store();
+            let (tx, rx) = watch::channel(None);
+            let token = store.next_token;
+            store.next_token += 1;
+            let rank = Rank { priority, seq: token };
+            store.queue.insert(rank, token);
+            let done = move || {
+                let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(task));
+                let outcome = match ran {
+                    Ok(()) => Ok(Bytes::new()),
+                    Err(_) => Err(Arc::from("a task panicked; this is a bug in pmc")),
+                };
+                tx.send_replace(Some(outcome));
+            };
+            store.jobs.insert(
+                token,
+                Job {
+                    id: None,
+                    rx: rx.clone(),
+                    waiters: 1,
+                    state: JobState::Queued {
+                        rank,
+                        work: Work::Task(Box::new(done)),
+                    },
+                },
+            );
+            let this = Arc::clone(self);
+            self.pool.spawn(move || this.work());
+            (rx, token)
+        };
+        let _waiter = Waiter { generator: self, token };
+        let outcome = match rx.wait_for(Option::is_some).await {
+            Ok(r) => r.clone(),
+            Err(_) => None,
+        };
+        match outcome {
+            Some(Ok(_)) => Ok(()),
+            Some(Err(e)) => Err(ChunkError::Failed(e)),
+            None => Err(ChunkError::Failed("the task was dropped".into())),
+        }
+    }
+
+    /// Runs task `token` (a worker took it from the queue; it catches its own panic and hands
+    /// on its outcome), then ends the job.
+    fn run_task(&self, token: u64, task: Box<dyn FnOnce() + Send>) {
+        task();
+        let mut store = self.store();
+        store.counts.running = store.counts.running.saturating_sub(1);
+        store.counts.done += 1;
+        store.jobs.remove(&token);
     }
 
     /// Drops the cached chunks of `planet`.

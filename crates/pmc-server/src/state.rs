@@ -199,15 +199,7 @@ impl AppState {
                 navs: std::sync::Mutex::new(std::collections::VecDeque::new()),
                 lod_errors: std::sync::Mutex::new(std::collections::HashMap::new()),
                 // a quarter of the chunk cache's bytes for built subtrees and their contents
-                tiles: crate::tiles_api::ServedTiles::new(
-                    config.tiles_frame,
-                    config.cache_bytes / 4,
-                    if config.threads == 0 {
-                        std::thread::available_parallelism().map_or(2, |n| n.get())
-                    } else {
-                        config.threads
-                    },
-                ),
+                tiles: crate::tiles_api::ServedTiles::new(config.tiles_frame, config.cache_bytes / 4),
                 stopping: tokio::sync::watch::Sender::new(false),
                 config,
             }),
@@ -253,6 +245,11 @@ impl AppState {
                 reused_shading: jobs.reused,
             },
         }
+    }
+
+    /// The chunk generator: its queue and workers also make the 3D Tiles files.
+    pub(crate) fn generator(&self) -> &Arc<Generator> {
+        &self.inner.generator
     }
 
     /// The 3D Tiles of the default planet.

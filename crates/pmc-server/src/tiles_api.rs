@@ -13,9 +13,10 @@
 //!
 //! A subtree file is made from the tiles' availability alone (`pmc_tiles::TileSet::subtree_file`:
 //! nothing meshed), a content when a client asks for it (`pmc_tiles::TileSet::content`); both are
-//! kept in a cache bounded by bytes, and requests for one being made wait for that one. At most
-//! as many are made at once as the server has worker threads; a request that goes away before
-//! its work starts withdraws it. An old revision's URLs are answered from the planet as it is
+//! kept in a cache bounded by bytes (a quarter of the chunk cache's), and requests for one being
+//! made wait for that one. The work goes through the chunk generator's queue and workers
+//! ([`crate::generator::Generator::task`]), beside the chunks of `/api/v1/chunk`: it counts in
+//! `/api/v1/stats`, and a request that goes away before its work starts withdraws it. An old revision's URLs are answered from the planet as it is
 //! now: the revision names a version for caches, it is not kept.
 
 use crate::chunk_cache::ByteCache;
@@ -29,8 +30,9 @@ use axum::response::{IntoResponse, Response};
 use pmc_geometry::Face;
 use pmc_tiles::{FrameChoice, TileCoord, TileOptions, TileSet};
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
-use tokio::sync::{watch, Semaphore};
+use tokio::sync::watch;
 
 /// A file made: the frame, the planet's revision, whether it is a content (else a subtree file),
 /// the tile.
@@ -74,19 +76,17 @@ pub(crate) struct ServedTiles {
     frame: FrameChoice,
     cache: Mutex<ByteCache<Key, Option<Bytes>>>,
     building: Mutex<HashMap<Key, watch::Receiver<Option<Built>>>>,
-    permits: Arc<Semaphore>,
     /// For each frame asked for, the tileset of the latest revision asked for.
     tilesets: Mutex<HashMap<Frame, (u64, Arc<TileSet>)>>,
 }
 
 impl ServedTiles {
-    /// Tiles placed in `frame`, with `cache_bytes` of files made and at most `builds` made at once.
-    pub(crate) fn new(frame: FrameChoice, cache_bytes: u64, builds: usize) -> ServedTiles {
+    /// Tiles placed in `frame`, with `cache_bytes` of files made.
+    pub(crate) fn new(frame: FrameChoice, cache_bytes: u64) -> ServedTiles {
         ServedTiles {
             frame,
             cache: Mutex::new(ByteCache::new(cache_bytes)),
             building: Mutex::new(HashMap::new()),
-            permits: Arc::new(Semaphore::new(builds.max(1))),
             tilesets: Mutex::new(HashMap::new()),
         }
     }
@@ -215,25 +215,23 @@ async fn made(state: &AppState, set: Arc<TileSet>, key: Key) -> Result<Option<By
         }
     };
     if let Some(tx) = tx {
-        // This request does the work. Leaving while waiting for a permit withdraws it.
-        struct Unlist<'a>(&'a ServedTiles, Key, bool);
+        // This request does the work, queued with the chunks. Leaving before a worker starts it
+        // withdraws it, and un-lists it so that the next request starts it again.
+        let started = Arc::new(AtomicBool::new(false));
+        struct Unlist<'a>(&'a ServedTiles, Key, Arc<AtomicBool>);
         impl Drop for Unlist<'_> {
             fn drop(&mut self) {
-                if !self.2 {
+                if !self.2.load(Ordering::SeqCst) {
                     lock(&self.0.building).remove(&self.1);
                 }
             }
         }
-        let mut unlist = Unlist(tiles, key, false);
-        let permit = tiles
-            .permits
-            .clone()
-            .acquire_owned()
-            .await
-            .map_err(|_| ApiError::internal("the server is stopping"))?;
-        // From here the work finishes and is kept even if this request goes away.
+        let _unlist = Unlist(tiles, key, started.clone());
         let st = state.clone();
-        let task = tokio::task::spawn_blocking(move || {
+        let out: Arc<Mutex<Option<Built>>> = Arc::default();
+        let slot = out.clone();
+        let task = move || {
+            started.store(true, Ordering::SeqCst);
             let made = if content {
                 set.content(&t).map(|c| c.map(Bytes::from))
             } else {
@@ -247,14 +245,26 @@ async fn made(state: &AppState, set: Arc<TileSet>, key: Key) -> Result<Option<By
             }
             lock(&tiles.building).remove(&key);
             let _ = tx.send(Some(built.clone()));
-            drop(permit);
-            built
-        });
-        unlist.2 = true;
-        let built: Built = task
-            .await
-            .map_err(|e| Arc::from(format!("making the tile failed: {e}")))
-            .and_then(|b| b);
+            *lock(&slot) = Some(built);
+        };
+        // (coarser tiles first: a client shows them before their children)
+        let priority = -f64::from(t.level);
+        if let Err(e) = state.generator().task(priority, task).await {
+            // The task failed without listing its end (a bug): un-list it, so that the requests
+            // waiting for it ask again.
+            let mut building = lock(&tiles.building);
+            if building.get(&key).is_some_and(|r| r.same_channel(&rx)) {
+                building.remove(&key);
+            }
+            let why = match e {
+                crate::generator::ChunkError::Failed(m) => m.to_string(),
+                other => format!("{other:?}"),
+            };
+            return Err(ApiError::internal(format!("making the tile failed: {why}")));
+        }
+        let built = lock(&out)
+            .take()
+            .unwrap_or_else(|| Err(Arc::from("the tile's task ended without a file")));
         return built.map_err(|e| ApiError::internal(e.to_string()));
     }
     loop {

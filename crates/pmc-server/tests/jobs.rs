@@ -404,3 +404,48 @@ async fn chunks_of_every_level_over_one_region_are_served_and_cached_apart() {
     }
     assert_eq!(stats(&a).await["generated"], requested);
 }
+
+/// The first content a subtree file names (a URL under `/tiles/r0/`).
+fn first_content(subtree: &Value) -> Option<String> {
+    fn find(node: &Value) -> Option<String> {
+        let uri = node["content"]["uri"].as_str().filter(|u| u.ends_with(".glb"));
+        uri.map(|u| format!("/tiles/r0/{}", u.trim_start_matches("../../../../../")))
+            .or_else(|| node["children"].as_array()?.iter().find_map(find))
+    }
+    find(&subtree["root"])
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn tiles_are_made_by_the_chunk_workers_and_abandoned_ones_are_dropped() {
+    let a = app(slow_config());
+    let ts = get(&a, "/tiles/tileset.json").await.json();
+    let face = ts["root"]["children"][0]["content"]["uri"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let sub = get(&a, &format!("/tiles/{face}")).await;
+    assert_eq!(sub.status, StatusCode::OK);
+    // the subtree file was a job of the generator
+    let before = stats_until(&a, "the subtree file's job done", |s| jobs(s, "done") == 1).await;
+    assert_eq!(jobs(&before, "running") + jobs(&before, "queued"), 0);
+    let content = first_content(&sub.json()).expect("a content");
+    // The one worker busy with a chunk: the tile's job waits in the chunks' queue.
+    let blocker = spawn_get(&a, chunk_uri(&surface_chunks()[0]));
+    stats_until(&a, "a running job", |s| jobs(s, "running") == 1).await;
+    let tile = spawn_get(&a, content.clone());
+    stats_until(&a, "the tile's job queued", |s| jobs(s, "queued") == 1).await;
+    tile.abort();
+    assert!(cancelled(tile.await));
+    let s = stats_until(&a, "the tile's job dropped", |s| jobs(s, "dropped") == 1).await;
+    assert_eq!(jobs(&s, "queued"), 0, "{s}");
+    assert_eq!(blocker.await.unwrap().status, StatusCode::OK);
+    // Asked for again, it is made (and was not left half-listed).
+    let r = get(&a, &content).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
+    assert_eq!(&r.body[..4], b"glTF");
+    let s = stats_until(&a, "no job left", |s| jobs(s, "queued") + jobs(s, "running") == 0).await;
+    assert_eq!(jobs(&s, "done"), 3, "the subtree file, the chunk, the tile: {s}");
+    // A file made is served from the tiles' cache: no new job.
+    assert_eq!(get(&a, &content).await.status, StatusCode::OK);
+    assert_eq!(jobs(&stats(&a).await, "done"), 3);
+}
