@@ -581,6 +581,19 @@ impl Generator {
         store.jobs.remove(&token);
     }
 
+    /// The revision of the latest edit that changed chunk `key` of `planet` (its mesh at any
+    /// revision from this one on is the same), 0 when none did since the server started.
+    pub fn changed_revision(&self, planet: &PlanetId, key: ChunkKey) -> u64 {
+        let store = self.store();
+        let id = ChunkId {
+            planet: planet.clone(),
+            key,
+            seams: SideMask(0),
+        };
+        let changed = store.changed_at.get(&id).copied().unwrap_or(0);
+        changed.max(store.min_revision.get(planet).copied().unwrap_or(0))
+    }
+
     /// Drops the cached chunks of `planet`.
     pub fn forget_planet(&self, planet: PlanetId) {
         let mut store = self.store();

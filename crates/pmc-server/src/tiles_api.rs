@@ -34,8 +34,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use tokio::sync::watch;
 
-/// A file made: the frame, the planet's revision, whether it is a content (else a subtree file),
-/// the tile.
+/// A file made: the frame, the planet's revision (for a content, the revision of the last edit
+/// that changed its chunk), whether it is a content (else a subtree file), the tile.
 type Key = (Frame, u64, bool, TileCoord);
 
 /// The frame a URL asks for: the server's (`/tiles/...`) or one named (`/tiles/sphere/...`).
@@ -327,10 +327,25 @@ async fn subtree_file(state: &AppState, frame: Frame, p: TilePath) -> Result<Res
 }
 
 async fn content_file(state: &AppState, frame: Frame, p: TilePath) -> Result<Response, ApiError> {
-    let (current, set) = tileset(state, frame).await?;
+    let (mut current, mut set) = tileset(state, frame).await?;
     let (revision, t) = parse(&set, &p, ".glb")?;
     check_revision(revision, current)?;
-    match made(state, set, (frame, current, true, t)).await? {
+    // A content is its chunk's closed mesh: the same bytes from the revision of the last edit
+    // that changed the chunk on. Kept under that revision, so that after an edit the tiles it
+    // did not touch are served from the cache under their new URLs.
+    let planet = Arc::new(state.config().terrain.clone());
+    let changed = |set: &TileSet| {
+        set.tiling()
+            .key(&t)
+            .map_or(0, |key| state.generator().changed_revision(&planet, key))
+    };
+    let mut version = changed(&set);
+    if version > current {
+        // an edit landed since the tileset was taken: take the planet with it
+        (current, set) = tileset(state, frame).await?;
+        version = changed(&set);
+    }
+    match made(state, set, (frame, version.min(current), true, t)).await? {
         Some(glb) => Ok(respond(glb, "model/gltf-binary", "public, max-age=3600")),
         None => Err(ApiError::not_found(format!(
             "tile {}/{} has no content (its subtree file says so)",

@@ -2,7 +2,7 @@
 //! and contents over HTTP, the same bytes as the library's, errors for bad paths, and new URLs
 //! after an edit.
 
-use crate::common::{get, send, small_config};
+use crate::common::{get, jobs, send, small_config, stats_until};
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use pmc_server::{router, AppState, ServerConfig};
@@ -168,4 +168,103 @@ async fn a_frame_named_in_the_path_places_the_tiles_in_it() {
             "{uri}"
         );
     }
+}
+
+/// Every content of the served tileset at its current revision: (path after `rN/`, bytes), and
+/// the number of subtree files walked.
+async fn all_contents(app: &axum::Router) -> (Vec<(String, Vec<u8>)>, usize) {
+    let ts = get(app, "/tiles/tileset.json").await.json();
+    let rev = format!("r{}", ts["extras"]["pmc"]["revision"]);
+    let mut todo: Vec<String> = ts["root"]["children"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| format!("/tiles/{}", f["content"]["uri"].as_str().unwrap()))
+        .collect();
+    let (mut out, mut subtrees) = (Vec::new(), 0);
+    while let Some(url) = todo.pop() {
+        let r = get(app, &url).await;
+        assert_eq!(r.status, StatusCode::OK, "{url}");
+        subtrees += 1;
+        let mut found = Vec::new();
+        uris(&r.json()["root"], &mut found);
+        for u in found {
+            let abs = resolve(&rev, &u);
+            if abs.ends_with(".json") {
+                todo.push(abs);
+            } else {
+                let c = get(app, &abs).await;
+                assert_eq!(c.status, StatusCode::OK, "{abs}");
+                let path = abs.split_once(&format!("{rev}/")).unwrap().1.to_string();
+                out.push((path, c.body.to_vec()));
+            }
+        }
+    }
+    out.sort();
+    (out, subtrees)
+}
+
+#[tokio::test]
+async fn after_an_edit_only_the_tiles_it_touched_are_made_again() {
+    let dir = std::env::temp_dir().join(format!("pmc-server-tiles-reuse-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = ServerConfig {
+        world: Some(dir.join("w.pmcw")),
+        ..small_config()
+    };
+    let app = router(AppState::new(config).unwrap());
+    let (before, _) = all_contents(&app).await;
+    let planet = get(&app, "/api/v1/planet").await.json();
+    // a pit at the north pole, through whatever the ground's height is there
+    let (base, top) = (
+        planet["base_radius"].as_f64().unwrap(),
+        planet["radius"].as_f64().unwrap(),
+    );
+    let mut touched = std::collections::HashSet::new();
+    for k in 2..=3 {
+        let y = base + (top - base) * f64::from(k) / 5.0;
+        let edit = json!({"brush": "remove", "x": 0.0, "y": y, "z": 0.0, "radius": 30.0});
+        let req = Request::post("/api/v1/edits")
+            .header("content-type", "application/json")
+            .body(Body::from(edit.to_string()))
+            .unwrap();
+        let r = send(&app, req).await;
+        assert_eq!(r.status, StatusCode::OK);
+        for c in r.json()["chunks"].as_array().unwrap() {
+            touched.insert(c.as_str().unwrap().to_string());
+        }
+    }
+    let done = |s: &Value| s["jobs"]["done"].as_u64().unwrap();
+    let jobs_before = done(&stats_until(&app, "no job left", |s| jobs(s, "queued") + jobs(s, "running") == 0).await);
+    let (after, subtrees) = all_contents(&app).await;
+    // (a job is counted done just after it answers)
+    let s = stats_until(&app, "no job left", |s| jobs(s, "queued") + jobs(s, "running") == 0).await;
+    let made = done(&s) - jobs_before - subtrees as u64;
+    // The tree is the same (the pits are inside the tiles), each tile's content is its chunk's.
+    assert!(before.iter().map(|c| &c.0).eq(after.iter().map(|c| &c.0)));
+    let chunk = |glb: &[u8]| {
+        let jlen = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+        let doc: Value = serde_json::from_slice(&glb[20..20 + jlen]).unwrap();
+        doc["asset"]["extras"]["pmc"]["chunk"].as_str().unwrap().to_string()
+    };
+    let (mut hit, mut changed) = (0, 0);
+    for ((_, b), (path, a)) in before.iter().zip(&after) {
+        if touched.contains(&chunk(a)) {
+            hit += 1;
+            changed += usize::from(a != b);
+        } else {
+            assert_eq!(a, b, "{path}: a tile the edits did not touch changed");
+        }
+    }
+    // The pits are there, and exactly the tiles they touched were made again.
+    assert!(changed >= 1, "no content changed after the edits");
+    assert_eq!(
+        made as usize,
+        hit,
+        "{made} contents made again, {hit} touched of {}",
+        after.len()
+    );
+    assert!(hit < after.len(), "every tile touched: the test shows nothing");
+    let _ = std::fs::remove_dir_all(&dir);
 }

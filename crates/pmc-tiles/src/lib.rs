@@ -175,21 +175,29 @@ pub fn planet_extras(planet: &Planet, edits: Option<usize>) -> Value {
 /// the caps (seen only through a crack between levels) from the surface.
 pub const CAP_MATERIAL: u8 = 255;
 
-/// How far a tile's caps are moved out from its chunk's centre, as a fraction of their distance
-/// to it: a ten-thousandth (3 mm on a 38 m chunk, 3 m on a 40 km one), far beyond the `f32`
+/// How far a tile's caps are moved out from its chunk's centre (and as far down), as a fraction
+/// of their horizontal distance to it: a ten-thousandth (2 mm on a 38 m chunk, 2 m on a 40 km
+/// one), far beyond the `f32`
 /// rounding of a client drawing each tile relative to its own centre (about 1e-7 of the
 /// distance to the eye), far below a pixel.
 pub const CAP_OFFSET: f64 = 1e-4;
 
 /// Gives a closed chunk's caps vertices of their own, copies of the surface's border vertices
-/// with material [`CAP_MATERIAL`], moved out from `centre` (relative to the mesh's origin) by
-/// [`CAP_OFFSET`] of their distance to it, and joins each border edge of the surface to its cap
-/// by a *flange* (two triangles): the tile stays closed, and its caps now lie a hair past the
-/// chunk's sides, so that two tiles meeting there overlap by that hair instead of touching. A
-/// client that draws them with `f32` rounding then leaves no pinhole along their seam: a pixel's
-/// ray that slips between the two surfaces meets a flange. The surface is the triangles of the
-/// mesh's cubes; the caps are the triangles after them.
-fn separate_caps(mesh: &mut ChunkMesh, centre: DVec3) {
+/// with material [`CAP_MATERIAL`], moved out from `centre` (relative to the mesh's origin) and
+/// down, and joins each border edge of the surface to its cap by a *flange* (two triangles): the
+/// tile stays closed, and its caps now lie a hair past the chunk's sides, so that two tiles
+/// meeting there overlap by that hair instead of touching. A client that draws them with `f32`
+/// rounding then leaves no pinhole along their seam: a pixel's ray that slips between the two
+/// surfaces meets a flange. The surface is the triangles of the mesh's cubes; the caps are the
+/// triangles after them.
+///
+/// The move: out along the vertex's horizontal offset from the centre (perpendicular to the
+/// planet's radius through the vertex; the planet's centre is at `-origin`) by [`CAP_OFFSET`] of
+/// it, and down toward the planet's centre by as much. Never up: a cap's top edge moved up
+/// would stand above a neighbour's surface that falls away from the seam, a sliver of wall seen
+/// from above (a dashed line along the faces' edges from orbit); moved down it stays under any
+/// neighbour that falls less steeply than 45 degrees within the hair.
+fn separate_caps(mesh: &mut ChunkMesh, centre: DVec3, origin: DVec3) {
     let surface = 3 * mesh.cube_runs.last().map_or(0, |r| r[1] as usize);
     if surface == mesh.indices.len() {
         return;
@@ -201,25 +209,61 @@ fn separate_caps(mesh: &mut ChunkMesh, centre: DVec3) {
             cap_edges.insert((t[e], t[(e + 1) % 3]));
         }
     }
+    // Each cap vertex is shaded as the surface above it: its attributes are those of the
+    // surface's border vertex nearest to it across the radius (itself, on the border), so that
+    // a pixel where a client shows a cap (a seam's rounding, a crack) has the surface's colour.
+    let position = |m: &ChunkMesh, i: usize| {
+        let low = m.positions_low.get(i).copied().unwrap_or([0.0; 3]);
+        DVec3::from(m.positions[i].map(f64::from)) + DVec3::from(low.map(f64::from))
+    };
+    let on_surface: std::collections::HashSet<u32> = mesh.indices[..surface].iter().copied().collect();
+    let mut border: Vec<u32> = mesh.indices[surface..]
+        .iter()
+        .copied()
+        .filter(|v| on_surface.contains(v))
+        .collect();
+    border.sort_unstable();
+    border.dedup();
+    let border: Vec<(u32, DVec3)> = border.into_iter().map(|v| (v, position(mesh, v as usize))).collect();
+    let above = |m: &ChunkMesh, v: u32| -> usize {
+        if on_surface.contains(&v) {
+            return v as usize;
+        }
+        let p = position(m, v as usize);
+        let up = (p + origin).normalize_or_zero();
+        let across = |q: DVec3| {
+            let d = q - p;
+            (d - up * d.dot(up)).length_squared()
+        };
+        border
+            .iter()
+            .min_by(|a, b| across(a.1).total_cmp(&across(b.1)))
+            .map_or(v as usize, |b| b.0 as usize)
+    };
     let mut copy: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
     for n in surface..mesh.indices.len() {
         let v = mesh.indices[n];
         let c = *copy.entry(v).or_insert_with(|| {
             let i = v as usize;
+            let from = above(mesh, v);
             let m = &mut *mesh;
             let low = m.positions_low.get(i).copied().unwrap_or([0.0; 3]);
             let p = DVec3::from(m.positions[i].map(f64::from)) + DVec3::from(low.map(f64::from));
-            let moved = centre + (p - centre) * (1.0 + CAP_OFFSET);
+            let up = (p + origin).normalize_or_zero();
+            let d = p - centre;
+            let out = d - up * d.dot(up);
+            let step = CAP_OFFSET * out.length();
+            let moved = p + out * CAP_OFFSET - up * step;
             let high = moved.as_vec3();
             m.positions.push(high.to_array());
             if !m.positions_low.is_empty() {
                 m.positions_low.push((moved - high.as_dvec3()).as_vec3().to_array());
             }
-            m.normals.push(m.normals[i]);
+            m.normals.push(m.normals[from]);
             m.edge_keys.push(m.edge_keys[i]);
-            m.heights.push(m.heights[i]);
-            m.water_depths.push(m.water_depths[i]);
-            m.colors.push(m.colors[i]);
+            m.heights.push(m.heights[from]);
+            m.water_depths.push(m.water_depths[from]);
+            m.colors.push(m.colors[from]);
             m.materials.push(CAP_MATERIAL);
             if !m.vertex_edges.is_empty() {
                 m.vertex_edges.push(m.vertex_edges[i]);
@@ -387,9 +431,8 @@ impl TileSet {
 
     /// Whether the tile may be in the tileset, by what costs nothing to tell: it exists, is within
     /// the levels asked for and meets the region, and its chunk lies within the planet's radial
-    /// bounds ([`pmc_planet::Planet::may_hold_surface`]). A subtree file lists each child subtree
-    /// that may be there; the child's own file says whether its root is
-    /// ([`TileSet::available`]).
+    /// bounds ([`pmc_planet::Planet::may_hold_surface`]). [`TileSet::available`] then samples
+    /// the chunk.
     pub fn candidate(&self, t: &TileCoord) -> bool {
         if t.level >= self.available_levels() || !self.tiling.exists(t) {
             return false;
@@ -458,7 +501,7 @@ impl TileSet {
         };
         let mut mesh = self.closed_mesh(key);
         let origin = mesh.origin;
-        separate_caps(&mut mesh, self.planet_sphere(t).0 - origin);
+        separate_caps(&mut mesh, self.planet_sphere(t).0 - origin, origin);
         let (centre, _) = self.sphere(t);
         for i in 0..mesh.vertex_count() {
             let w = mesh.world_position_full(i);
@@ -621,7 +664,8 @@ impl TileSet {
     }
 
     /// The child subtrees of the subtree rooted at `root` whose tiles are `tiles`: the tiles one
-    /// level below it that are candidates under an available tile, in Morton order.
+    /// level below it that are available (sampled: never a leaf without content, see
+    /// `docs/specs/tiles-v1.md`) under an available tile, in Morton order.
     fn children_of(&self, root: TileCoord, tiles: &Bits) -> Vec<TileCoord> {
         let below = 1u64 << (3 * u32::from(SUBTREE_LEVELS));
         let last = octree_tiles(SUBTREE_LEVELS - 1) as usize;
@@ -630,7 +674,7 @@ impl TileSet {
             .filter_map(|m| {
                 let (x, y, z) = demorton3(m);
                 let t = root.descendant(SUBTREE_LEVELS, x, y, z);
-                (tiles.get(last + (m >> 3) as usize) && self.candidate(&t)).then_some(t)
+                (tiles.get(last + (m >> 3) as usize) && self.available(&t)).then_some(t)
             })
             .collect()
     }

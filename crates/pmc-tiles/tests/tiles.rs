@@ -374,7 +374,7 @@ fn subtree_files_hold_their_tiles_spheres_errors_and_contents() {
             assert_eq!(node["boundingVolume"]["sphere"], json!([c.x, c.y, c.z, r]), "{t:?}");
             assert_eq!(node["geometricError"].as_f64().unwrap(), tiles.geometric_error(t));
             if *is_subtree {
-                assert!(tiles.candidate(t), "{t:?}");
+                assert!(tiles.available(t), "{t:?}");
                 assert_eq!(t.level, root.level + SUBTREE_LEVELS);
                 children.push(*t);
             } else {
@@ -630,5 +630,41 @@ fn plateau_of_level_errors_gives_strictly_falling_tile_errors() {
     for (_, b) in all_subtrees(&tiles) {
         let doc: Value = serde_json::from_slice(&b.subtree).unwrap();
         falls(&doc["root"]);
+    }
+}
+
+/// Regression (CesiumJS stopped refining 1.5 km over the ground, drawing tiles of level 8: a child
+/// subtree listed from the cheap tests alone had an empty root, a leaf without content, and
+/// CesiumJS never refines a tile with such a child in view): every subtree file reached from
+/// the tileset has a root with content or children, with and without a region.
+#[test]
+fn no_subtree_file_reached_is_an_empty_leaf() {
+    let region = Some(Region {
+        lat: 20.0,
+        lon: 30.0,
+        radius: 150.0,
+    });
+    // a planet of 16 chunks a side: tile levels 0 to 4, child subtrees at level 3
+    let layout = Layout::new(16, 8, 2000.0, 2.0, 4).unwrap();
+    let planet = Arc::new(Planet::new(PresetKind::Earthlike, 3, layout));
+    let errors = pmc_lod::measure_level_errors(&planet, 64, 0x5eed);
+    for options in [
+        TileOptions::default(),
+        TileOptions {
+            region,
+            ..TileOptions::default()
+        },
+    ] {
+        let tiles = TileSet::new(planet.clone(), errors.clone(), TileFrame::Sphere, options, "pmc test").unwrap();
+        let subtrees = all_subtrees(&tiles);
+        assert!(subtrees.keys().any(|t| t.level >= 3), "no child subtree to test");
+        for (root, b) in &subtrees {
+            let doc: Value = serde_json::from_slice(&b.subtree).unwrap();
+            let r = &doc["root"];
+            assert!(
+                r.get("content").is_some() || r["children"].as_array().is_some_and(|c| !c.is_empty()),
+                "{root:?}: an empty leaf"
+            );
+        }
     }
 }
