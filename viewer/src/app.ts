@@ -817,7 +817,7 @@ export class App implements TestHookTarget {
       import('./tilesMode')
         .then(({ TilesView }) => {
           if (!this.tilesOn || this.tiles) return;
-          this.tiles = new TilesView(new URL(TILESET_PATH, document.baseURI).href, this.scene.scene, this.scene.waterUniforms(), {
+          this.tiles = new TilesView(new URL(TILESET_PATH, document.baseURI).href, this.scene.scene, this.scene, {
             onChange: () => {
               this.tilesPicture++;
               this.cameras.groundChanged();

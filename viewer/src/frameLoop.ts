@@ -9,7 +9,7 @@ import { FOV, type CameraController } from './cameraController';
 import { metresPerPixel, rayToSphere, scaleBar } from './hud';
 import { formatLevels } from './chunkSelection';
 import type { ChunkStreamer } from './chunkStreamer';
-import { length, normalize, type V3 } from './frames';
+import { length, type V3 } from './frames';
 import type { Input, InputFrame } from './input';
 import type { PlanetParams } from './planetParams';
 import { PictureKey } from './pictureKey';
@@ -187,7 +187,7 @@ export class FrameLoop {
     // chunk is asked for (those loaded stay, hidden), the tiles select theirs at the same
     // screen-space error and load them
     if (tilesMode) {
-      tiles?.update(cameras.camera, renderer, selection.settings.maxPixelError, scene.sunDirection(), normalize(pos), now);
+      tiles?.update(cameras.camera, renderer, selection.settings.maxPixelError, now);
     } else {
       const viewportHeightPx = renderer.getDrawingBufferSize(new THREE.Vector2()).y;
       selection.frame(cameras.camera, viewportHeightPx, pos, basis.forward, basis.up, now, steps.busy() !== null);

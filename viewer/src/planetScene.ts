@@ -67,28 +67,6 @@ export interface DebugFlags {
   sea: boolean;
 }
 
-/**
- * The terrain's uniforms of its water (`PlanetScene.waterUniforms`): the objects the terrain's
- * materials share, for the sea's surface (shaders.ts `SEA_SURFACE`) over ground under the sea.
- */
-export interface WaterUniforms {
-  /** 1: water drawn over ground under the sea; 0: not (test mode). */
-  uWater: { value: number };
-  /** Linear RGB: the light the water keeps in the shallows, and the colour of deep water. */
-  uWaterShallow: { value: THREE.Vector3 };
-  uWaterDeep: { value: THREE.Vector3 };
-  /** Metres of water that absorb most light. */
-  uWaterScale: { value: number };
-  /** The sea surface's colour and the sky's it reflects (linear RGB), the sun (planet frame, unit). */
-  uSeaColour: { value: THREE.Vector3 };
-  uSkyColour: { value: THREE.Vector3 };
-  uSunDir: { value: THREE.Vector3 };
-  /** The eye's place, planet frame (its f32 part: for directions). */
-  uEyeHigh: { value: THREE.Vector3 };
-  /** 1: lit; 0: the test mode without lighting. */
-  uLighting: { value: number };
-}
-
 /** A vertex of a chunk shown (`PlanetScene.sampleVertices`). */
 export interface SampledVertex {
   /** Planet frame, metres (f64: the chunk origin plus the f32 offset). */
@@ -106,6 +84,8 @@ export class PlanetScene {
   readonly scene = new THREE.Scene();
   private readonly terrainGroup = new THREE.Group();
   private readonly chunks = new Map<string, ChunkObject>();
+  /** Every terrain material not disposed yet (`terrainMaterial`): the chunks' and the 3D Tiles mode's tiles'. */
+  private readonly terrainMaterials = new Set<THREE.ShaderMaterial>();
   /** The sky and the aerial perspective (atmosphere.ts); its uniforms are in every terrain material. */
   readonly atmosphere = new Atmosphere();
   private readonly shared = {
@@ -313,6 +293,7 @@ export class PlanetScene {
     s.uHasSea.value = params.seaRadius !== null ? 1 : 0;
     s.uWaterScale.value = params.waterScale;
     s.uNoiseFreq.value = params.noiseFreq;
+    for (const m of this.terrainMaterials) this.originMod(m);
     this.setImagery(null, null);
     this.setRelief(null, null);
     this.syncFog();
@@ -382,46 +363,7 @@ export class PlanetScene {
     // bounds of the vertices, relative to the chunk origin (for three.js's frustum culling)
     g.computeBoundingSphere();
     g.computeBoundingBox();
-
-    const period = this.params.noisePeriod;
-    const detailPeriod = this.params.detailPeriod;
-    const material = new THREE.ShaderMaterial({
-      vertexShader: terrainVertex,
-      fragmentShader: terrainFragment,
-      uniforms: {
-        ...this.shared,
-        uOrigin: { value: new THREE.Vector3(origin[0], origin[1], origin[2]) },
-        uOriginMod: {
-          value: new THREE.Vector3(
-            modPositive(origin[0], period),
-            modPositive(origin[1], period),
-            modPositive(origin[2], period),
-          ),
-        },
-        uOriginModDetail: {
-          value: new THREE.Vector3(
-            modPositive(origin[0], detailPeriod),
-            modPositive(origin[1], detailPeriod),
-            modPositive(origin[2], detailPeriod),
-          ),
-        },
-        uFaceColour: { value: new THREE.Vector3(...(FACE_COLOURS[chunk.face] ?? [1, 1, 1])) },
-      },
-      wireframe: this.flags.wireframe,
-      // every terrain pixel marks the stencil: the sea disk is not drawn over it
-      stencilWrite: true,
-      stencilRef: TERRAIN_STENCIL,
-      stencilFunc: THREE.AlwaysStencilFunc,
-      stencilZPass: THREE.ReplaceStencilOp,
-      // with the back-face flag on, faces seen from inside the solid are drawn (in magenta)
-      side: this.flags.backfaces ? THREE.DoubleSide : THREE.FrontSide,
-      defines: plainDefines(this.flags.plain),
-    });
-    if (this.flags.borders) {
-      material.polygonOffset = true;
-      material.polygonOffsetFactor = 1;
-      material.polygonOffsetUnits = 1;
-    }
+    const material = this.terrainMaterial(origin, chunk.face);
     const mesh = new THREE.Mesh(g, material);
     mesh.name = key;
     mesh.userData['seams'] = seams;
@@ -448,6 +390,61 @@ export class PlanetScene {
     }
     this.changes++;
     if (this.flags.borders) this.addBorders(obj, chunk.indices, chunk.vertexCount);
+  }
+
+  /**
+   * A terrain material (the terrain shader, the uniforms every terrain material shares, the debug
+   * flags) for a mesh drawn as a chunk: its `position` relative to `origin` (planet frame, f64),
+   * its place in `aPosHigh` and `aPosLow`, and a chunk's attributes (`addChunk`); `face` picks the
+   * debug colour. The chunks' and the 3D Tiles mode's tiles' (tileTerrain.ts); kept up to date
+   * with the debug flags and the planet until disposed.
+   */
+  terrainMaterial(origin: V3, face: number): THREE.ShaderMaterial {
+    const material = new THREE.ShaderMaterial({
+      vertexShader: terrainVertex,
+      fragmentShader: terrainFragment,
+      uniforms: {
+        ...this.shared,
+        uOrigin: { value: new THREE.Vector3(origin[0], origin[1], origin[2]) },
+        uOriginMod: { value: new THREE.Vector3() },
+        uOriginModDetail: { value: new THREE.Vector3() },
+        uFaceColour: { value: new THREE.Vector3(...(FACE_COLOURS[face] ?? [1, 1, 1])) },
+      },
+      // every terrain pixel marks the stencil: the sea disk is not drawn over it
+      stencilWrite: true,
+      stencilRef: TERRAIN_STENCIL,
+      stencilFunc: THREE.AlwaysStencilFunc,
+      stencilZPass: THREE.ReplaceStencilOp,
+    });
+    material.userData['origin'] = [origin[0], origin[1], origin[2]];
+    this.originMod(material);
+    this.applyFlags(material);
+    this.terrainMaterials.add(material);
+    material.addEventListener('dispose', () => this.terrainMaterials.delete(material));
+    return material;
+  }
+
+  /** A terrain material's origin modulo the periods of the planet's noises (computed in f64). */
+  private originMod(material: THREE.ShaderMaterial): void {
+    const origin = material.userData['origin'] as V3;
+    const u = material.uniforms;
+    const period = this.params?.noisePeriod ?? 1;
+    const detailPeriod = this.params?.detailPeriod ?? 1;
+    (u['uOriginMod']!.value as THREE.Vector3).set(...(origin.map((x) => modPositive(x, period)) as V3));
+    (u['uOriginModDetail']!.value as THREE.Vector3).set(...(origin.map((x) => modPositive(x, detailPeriod)) as V3));
+  }
+
+  /** A terrain material drawn as the debug flags say. */
+  private applyFlags(material: THREE.ShaderMaterial): void {
+    const flags = this.flags;
+    material.wireframe = flags.wireframe;
+    // with the back-face flag on, faces seen from inside the solid are drawn (in magenta)
+    material.side = flags.backfaces ? THREE.DoubleSide : THREE.FrontSide;
+    material.defines = plainDefines(flags.plain);
+    material.polygonOffset = flags.borders;
+    material.polygonOffsetFactor = 1;
+    material.polygonOffsetUnits = 1;
+    material.needsUpdate = true;
   }
 
   private addBorders(obj: ChunkObject, indices: ArrayLike<number>, vertexCount: number): void {
@@ -497,15 +494,8 @@ export class PlanetScene {
     this.syncFog();
     this.shared.uWater.value = next.sea ? 1 : 0;
     if (this.sea) this.sea.visible = !next.backfaces && next.sea;
+    for (const m of this.terrainMaterials) this.applyFlags(m);
     for (const obj of this.chunks.values()) {
-      const m = obj.mesh.material;
-      m.wireframe = next.wireframe;
-      m.side = next.backfaces ? THREE.DoubleSide : THREE.FrontSide;
-      m.defines = plainDefines(next.plain);
-      m.polygonOffset = next.borders;
-      m.polygonOffsetFactor = 1;
-      m.polygonOffsetUnits = 1;
-      m.needsUpdate = true;
       if (bordersChanged) {
         if (next.borders) {
           const index = obj.mesh.geometry.getIndex();
@@ -564,32 +554,6 @@ export class PlanetScene {
     if (this.terrainGroup.visible === visible) return;
     this.terrainGroup.visible = visible;
     this.changes++;
-  }
-
-  /**
-   * The terrain's uniforms of its water (on or off, its colours, the depth that absorbs most
-   * light, the sea's surface): the 3D Tiles mode draws the water over the tiles' ground under the
-   * sea with them, as the terrain does.
-   */
-  waterUniforms(): WaterUniforms {
-    const s = this.shared;
-    return {
-      uWater: s.uWater,
-      uWaterShallow: s.uWaterShallow,
-      uWaterDeep: s.uWaterDeep,
-      uWaterScale: s.uWaterScale,
-      uSeaColour: s.uSeaColour,
-      uSkyColour: s.uSkyColour,
-      uSunDir: s.uSunDir,
-      uEyeHigh: s.uEyeHigh,
-      uLighting: s.uLighting,
-    };
-  }
-
-  /** The sun's direction (planet frame, unit), as the last `setSun` set it. */
-  sunDirection(): V3 {
-    const d = this.shared.uSunDir.value;
-    return [d.x, d.y, d.z];
   }
 
   /** Chunk meshes for raycasting (walk mode). */

@@ -1,24 +1,29 @@
 // The 3D Tiles mode: the planet as `pmc serve` answers it in OGC 3D Tiles
-// (docs/specs/tiles-v1.md, the `sphere` frame: the planet as the viewer draws it), loaded and
-// drawn by NASA-AMMOS's 3DTilesRendererJS instead of the viewer's own chunk streaming, to compare
-// the two paths on the same view. Loaded when the mode is first turned on (a chunk of the build of
-// its own: the renderer and three.js's glTF loader).
+// (docs/specs/tiles-v1.md, the `sphere` frame: the planet as the viewer draws it), loaded by
+// NASA-AMMOS's 3DTilesRendererJS instead of the viewer's own chunk streaming, and drawn by the
+// viewer's own terrain shader as the chunks are, to compare the two paths' geometry on the same
+// view. Loaded when the mode is first turned on (a chunk of the build of its own: the renderer and
+// three.js's glTF loader).
 //
 // The tiles' group is placed around the floating origin every frame (tiles.ts: ECEF to the planet
 // frame, then -camera, in f64). The tiles pick their levels with the viewer's own screen-space
-// error target, in the drawing buffer's pixels as the viewer's selection counts them. Their glTF's
-// MeshStandardMaterial keeps its vertex colours (COLOR_0) and is lit by lights that follow the
-// viewer's sun, weighted as the terrain shader weighs its own light (shaders.ts: 0.15 ambient,
-// 0.2 sky, 0.72 sun). As the terrain does, the tiles mark the stencil (the sea disk is not drawn
-// over them) and draw the water themselves over the ground under the sea, from their
-// `_WATER_DEPTH`: from orbit a coarse tile's triangles are chords that pass kilometres under the
-// sea's sphere, and the sea disk, drawn by depth, covered most of the land.
+// error target, in the drawing buffer's pixels as the viewer's selection counts them. Each tile's
+// mesh, when it loads, is turned into a chunk's (tileTerrain.ts: its vertices in the planet frame
+// in high and low f32 parts, relative to the tile's centre, its normals turned, its heights, water
+// depths and materials as the chunk's attributes) and drawn with a terrain material of the
+// planet's scene (planetScene.ts `terrainMaterial`): the same materials per pixel, sun, sky light,
+// haze, water under the sea and stencil as the chunks. A tile's caps (material 255, the sides of
+// its solid: docs/specs/tiles-v1.md) are drawn as the rest, from their own attributes, which copy
+// those of the surface's border: they look like the ground they close (the shader does not read
+// the material id). In rock, every seam between two tiles showed as a dotted line: a cap lies a
+// hair outside its tile, so along a seam it pokes centimetres out of the neighbour's ground.
 
 import * as THREE from 'three';
 import { TilesRenderer } from '3d-tiles-renderer';
+import { FACE_NAMES } from './chunkDecode';
+import type { PlanetScene } from './planetScene';
+import { matrixWithin, tileMeshMatrix, tileTerrain } from './tileTerrain';
 import type { V3 } from './frames';
-import { TERRAIN_STENCIL, type WaterUniforms } from './planetScene';
-import { SEA_SURFACE } from './shaders';
 import { TILES_QUIET_MS, tilesGroupMatrix, type TilesStats } from './tiles';
 
 export interface TilesViewCallbacks {
@@ -30,13 +35,9 @@ export interface TilesViewCallbacks {
   onTileset(frame: string | null, terrain: string | null): void;
 }
 
-/** The tiles of one TilesRenderer, their lights, and their place in the scene. */
+/** The tiles of one TilesRenderer and their place in the scene. */
 export class TilesView {
   private readonly tiles: TilesRenderer;
-  private readonly lights = new THREE.Group();
-  private readonly sun = new THREE.DirectionalLight(0xffffff, 0.72 * Math.PI);
-  private readonly sky = new THREE.HemisphereLight(0xffffff, 0x000000, 0.2 * Math.PI);
-  private readonly ambient = new THREE.AmbientLight(0xffffff, 0.15 * Math.PI);
   private readonly matrix: number[] = new Array<number>(16);
   private readonly buffer = new THREE.Vector2();
   private quietSince: number | null = null;
@@ -47,7 +48,7 @@ export class TilesView {
   constructor(
     url: string,
     private readonly scene: THREE.Scene,
-    private readonly water: WaterUniforms,
+    private readonly materials: Pick<PlanetScene, 'terrainMaterial'>,
     private readonly callbacks: TilesViewCallbacks,
   ) {
     this.tiles = new TilesRenderer(url);
@@ -58,13 +59,23 @@ export class TilesView {
     const changed = (): void => this.callbacks.onChange();
     this.tiles.addEventListener('tile-visibility-change', changed);
     this.tiles.addEventListener('load-model', (e) => {
+      const meshes: THREE.Mesh[] = [];
       e.scene.traverse((o) => {
-        const m = (o as THREE.Mesh).material;
-        for (const material of Array.isArray(m) ? m : m ? [m] : []) this.prepare(material);
+        if ((o as THREE.Mesh).isMesh) meshes.push(o as THREE.Mesh);
+      });
+      for (const mesh of meshes) this.prepare(mesh, e.scene);
+      changed();
+    });
+    this.tiles.addEventListener('dispose-model', (e) => {
+      // (the renderer disposes the glTF's own geometries and materials, not those made here)
+      e.scene.traverse((o) => {
+        const mesh = o as THREE.Mesh;
+        if (!mesh.isMesh || mesh.userData['pmcTerrain'] !== true) return;
+        mesh.geometry.dispose();
+        (mesh.material as THREE.Material).dispose();
       });
       changed();
     });
-    this.tiles.addEventListener('dispose-model', changed);
     this.tiles.addEventListener('load-root-tileset', (e) => {
       const pmc = (e.tileset.extras as { pmc?: { frame?: unknown; terrain?: unknown } } | undefined)?.pmc;
       this.frame = typeof pmc?.frame === 'string' ? pmc.frame : null;
@@ -78,33 +89,23 @@ export class TilesView {
       this.callbacks.onError(`3D Tiles: cannot load ${String(e.url)}: ${what}`);
     });
     this.scene.add(group);
-    this.lights.name = '3d-tiles-lights';
-    this.lights.add(this.sun, this.sky, this.ambient);
-    this.scene.add(this.lights);
   }
 
   /**
-   * A tile's material as the terrain's: it marks the stencil, and over ground under the sea it
-   * draws the water as the terrain shader does (shaders.ts: the light kept through the water's
-   * depth along the view, toward the deep water's colour, under the sea's surface).
+   * A tile's mesh (in its tile's scene `root`, not yet drawn) as a chunk: its geometry turned into a
+   * chunk's, a terrain material, and a matrix that puts it at (its centre - camera) under the
+   * tiles' group, as a chunk (tileTerrain.ts). The glTF's geometry and material, never drawn, are
+   * the renderer's to dispose with the tile.
    */
-  private prepare(material: THREE.Material): void {
-    material.stencilWrite = true;
-    material.stencilRef = TERRAIN_STENCIL;
-    material.stencilFunc = THREE.AlwaysStencilFunc;
-    material.stencilZPass = THREE.ReplaceStencilOp;
-    if (!(material instanceof THREE.MeshStandardMaterial)) return;
-    material.customProgramCacheKey = () => 'pmc-tiles-water';
-    material.onBeforeCompile = (shader) => {
-      Object.assign(shader.uniforms, this.water);
-      shader.vertexShader = shader.vertexShader
-        .replace('#include <common>', `#include <common>\n${WATER_VERTEX_HEAD}`)
-        .replace('#include <begin_vertex>', `#include <begin_vertex>\n${WATER_VERTEX}`);
-      shader.fragmentShader = shader.fragmentShader
-        .replace('#include <common>', `#include <common>\n${WATER_FRAGMENT_HEAD}`)
-        .replace('#include <opaque_fragment>', `${WATER_FRAGMENT}\n#include <opaque_fragment>`);
-    };
-    material.needsUpdate = true;
+  private prepare(mesh: THREE.Mesh, root: THREE.Object3D): void {
+    const { geometry, origin } = tileTerrain(mesh.geometry, matrixWithin(mesh, root));
+    const parents = mesh === root || !mesh.parent ? new THREE.Matrix4() : matrixWithin(mesh.parent, root);
+    mesh.geometry = geometry;
+    mesh.material = this.materials.terrainMaterial(origin, faceOf(mesh));
+    mesh.matrixAutoUpdate = false;
+    tileMeshMatrix(parents, origin, mesh.matrix);
+    mesh.matrixWorldNeedsUpdate = true;
+    mesh.userData['pmcTerrain'] = true;
   }
 
   /**
@@ -133,15 +134,10 @@ export class TilesView {
   }
 
   /**
-   * One frame with `camera` (placed, its matrices up to date): the lights follow the sun (`sun`,
-   * unit, planet frame) over the place under the camera (`up`, unit), the tiles pick their levels
-   * for the drawing buffer of `renderer` at `errorTarget` pixels and load what they lack.
+   * One frame with `camera` (placed, its matrices up to date): the tiles pick their levels for the
+   * drawing buffer of `renderer` at `errorTarget` pixels and load what they lack.
    */
-  update(camera: THREE.PerspectiveCamera, renderer: THREE.WebGLRenderer, errorTarget: number, sun: V3, up: V3, now: number): void {
-    // (render space has the planet frame's axes: directions are the same in both)
-    this.sun.position.set(sun[0], sun[1], sun[2]);
-    this.sky.position.set(up[0], up[1], up[2]);
-    this.lights.updateMatrixWorld(true);
+  update(camera: THREE.PerspectiveCamera, renderer: THREE.WebGLRenderer, errorTarget: number, now: number): void {
     const tiles = this.tiles;
     tiles.errorTarget = errorTarget;
     tiles.setCamera(camera);
@@ -191,54 +187,22 @@ export class TilesView {
     };
   }
 
-  /** Removes the tiles and their lights from the scene and frees what they hold. */
+  /** Removes the tiles from the scene and frees what they hold. */
   dispose(): void {
     this.disposed = true;
     this.scene.remove(this.tiles.group);
-    this.scene.remove(this.lights);
     this.tiles.dispose();
-    this.sun.dispose();
-    this.sky.dispose();
-    this.ambient.dispose();
   }
 }
 
-/** The tiles' water, in three.js's MeshStandardMaterial (`TilesView.prepare`): the vertex's part. */
-const WATER_VERTEX_HEAD = /* glsl */ `
-attribute float _water_depth; // the tiles' _WATER_DEPTH: metres under the sea's surface
-varying float vPmcWaterDepth;
-varying vec3 vPmcRel;         // render space: relative to the eye
-`;
-const WATER_VERTEX = /* glsl */ `
-vPmcWaterDepth = _water_depth;
-vPmcRel = (modelMatrix * vec4(transformed, 1.0)).xyz;
-`;
-/** ...and the fragment's: after the lighting, as in the terrain shader. */
-const WATER_FRAGMENT_HEAD = /* glsl */ `
-uniform float uWater;
-uniform vec3 uWaterShallow;
-uniform vec3 uWaterDeep;
-uniform float uWaterScale;
-uniform vec3 uSeaColour;
-uniform vec3 uSkyColour;
-uniform vec3 uSunDir;
-uniform vec3 uEyeHigh;
-uniform float uLighting;
-varying float vPmcWaterDepth;
-varying vec3 vPmcRel;
-${SEA_SURFACE}
-`;
-const WATER_FRAGMENT = /* glsl */ `
-if (uWater > 0.5 && vPmcWaterDepth > 0.0) {
-  vec3 pmcUp = normalize(vPmcRel + uEyeHigh);
-  vec3 pmcView = normalize(-vPmcRel);
-  float cosView = max(abs(dot(pmcView, pmcUp)), 0.2);
-  float path = vPmcWaterDepth * 0.5 * (1.0 + 1.0 / cosView);
-  float k = 1.0 - exp(-path / max(uWaterScale, 1e-3));
-  outgoingLight = mix(outgoingLight * uWaterShallow, uWaterDeep, k);
-  if (uLighting > 0.5) outgoingLight = pmcSeaSurface(outgoingLight, pmcUp, pmcView).rgb;
+/** The face of a tile's mesh, from its glTF node's or mesh's name (the chunk key, `face/level/i/j/k`); 0 if none. */
+function faceOf(mesh: THREE.Object3D): number {
+  for (let o: THREE.Object3D | null = mesh; o; o = o.parent) {
+    const face = FACE_NAMES.findIndex((f) => o.name.startsWith(f));
+    if (face >= 0) return face;
+  }
+  return 0;
 }
-`;
 
 /** The counts a TilesRenderer keeps (its `stats`, which its type declarations leave out). */
 type RendererStats = Record<'inCache' | 'queued' | 'downloading' | 'parsing' | 'loaded' | 'failed' | 'active' | 'visible', number>;
