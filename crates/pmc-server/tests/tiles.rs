@@ -88,16 +88,21 @@ async fn bad_tile_paths_get_a_reason() {
     }
 }
 
-#[tokio::test]
-async fn an_edit_gives_the_tileset_new_urls() {
-    let dir = std::env::temp_dir().join(format!("pmc-server-tiles-{}", std::process::id()));
+/// A server of the small planet with a world (editing on) in a new folder, and the folder.
+fn world_app(tag: &str) -> (axum::Router, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("{tag}{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let config = ServerConfig {
         world: Some(dir.join("w.pmcw")),
         ..small_config()
     };
-    let app = router(AppState::new(config).unwrap());
+    (router(AppState::new(config).unwrap()), dir)
+}
+
+#[tokio::test]
+async fn an_edit_gives_the_tileset_new_urls() {
+    let (app, dir) = world_app("pmc-server-tiles-");
     let before = get(&app, "/tiles/tileset.json").await.json();
     assert_eq!(before["extras"]["pmc"]["revision"], 0);
     assert!(before["root"]["children"][0]["content"]["uri"]
@@ -206,14 +211,7 @@ async fn all_contents(app: &axum::Router) -> (Vec<(String, Vec<u8>)>, usize) {
 
 #[tokio::test]
 async fn after_an_edit_only_the_tiles_it_touched_are_made_again() {
-    let dir = std::env::temp_dir().join(format!("pmc-server-tiles-reuse-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let config = ServerConfig {
-        world: Some(dir.join("w.pmcw")),
-        ..small_config()
-    };
-    let app = router(AppState::new(config).unwrap());
+    let (app, dir) = world_app("pmc-server-tiles-reuse-");
     let (before, _) = all_contents(&app).await;
     let planet = get(&app, "/api/v1/planet").await.json();
     // a pit at the north pole, through whatever the ground's height is there
