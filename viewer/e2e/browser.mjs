@@ -70,7 +70,8 @@ export async function openBrowser(gl = GL) {
       if (m.type() !== 'error' && m.type() !== 'warning') return;
       if (environmental.test(m.text())) return;
       if (expectedFailures.some((re) => re.test(m.location()?.url ?? ''))) return;
-      consoleProblems.push(`${tag}${m.type()}: ${m.text()}`);
+      const at = m.location()?.url ? ` (${m.location().url.replace(/^https?:\/\/[^/]+/, '')})` : '';
+      consoleProblems.push(`${tag}${m.type()}: ${m.text()}${at}`);
     });
     p.on('pageerror', (e) => consoleProblems.push(`${tag}uncaught: ${e.message}`));
     p.on('response', (r) => {
