@@ -323,7 +323,7 @@ impl Generator {
     ) -> Result<Bytes, ChunkError> {
         // -0 and +0 are one priority.
         let priority = priority + 0.0;
-        let (mut rx, token) = {
+        let (rx, token) = {
             let mut store = self.store();
             if let Some(bytes) = store.cache.get(&id) {
                 return Ok(bytes.clone());
@@ -344,32 +344,55 @@ impl Generator {
                         return Err(ChunkError::Busy);
                     }
                     let (tx, rx) = watch::channel(None);
-                    let token = store.next_token;
-                    store.next_token += 1;
-                    let rank = Rank { priority, seq: token };
-                    store.queue.insert(rank, token);
-                    store.jobs.insert(
-                        token,
-                        Job {
-                            id: Some(id.clone()),
-                            rx: rx.clone(),
-                            waiters: 1,
-                            state: JobState::Queued {
-                                rank,
-                                work: Work::Chunk { planet, revision, tx },
-                            },
-                        },
-                    );
+                    let work = Work::Chunk { planet, revision, tx };
+                    let token = self.enqueue(&mut store, priority, Some(id.clone()), rx.clone(), work);
                     store.pending.insert(id, token);
-                    // One worker task per queued job: each takes the best job queued when it
-                    // starts, or nothing when dropped jobs left the queue shorter.
-                    let this = Arc::clone(self);
-                    self.pool.spawn(move || this.work());
                     (rx, token)
                 }
             }
         };
-        // From here on, dropping this future (the request went away) lets go of the job.
+        self.outcome(rx, token, "the generation job was dropped").await
+    }
+
+    /// Queues job `work` (of chunk `id`, `None` for a task) at `priority`, its waiters sharing
+    /// `rx`, and starts a worker task for it; returns its token. One worker task per queued job:
+    /// each takes the best job queued when it starts, or nothing when dropped jobs left the
+    /// queue shorter.
+    fn enqueue(
+        self: &Arc<Self>,
+        store: &mut Store,
+        priority: f64,
+        id: Option<ChunkId>,
+        rx: watch::Receiver<Option<JobResult>>,
+        work: Work,
+    ) -> u64 {
+        let token = store.next_token;
+        store.next_token += 1;
+        let rank = Rank { priority, seq: token };
+        store.queue.insert(rank, token);
+        let state = JobState::Queued { rank, work };
+        store.jobs.insert(
+            token,
+            Job {
+                id,
+                rx,
+                waiters: 1,
+                state,
+            },
+        );
+        let this = Arc::clone(self);
+        self.pool.spawn(move || this.work());
+        token
+    }
+
+    /// The outcome of job `token`, waited for on `rx` (`dropped` when the job ended without
+    /// one). Dropping this future (the request went away) lets go of the job.
+    async fn outcome(
+        &self,
+        mut rx: watch::Receiver<Option<JobResult>>,
+        token: u64,
+        dropped: &str,
+    ) -> Result<Bytes, ChunkError> {
         let _waiter = Waiter { generator: self, token };
         let result = match rx.wait_for(Option::is_some).await {
             Ok(r) => r.clone(),
@@ -378,7 +401,7 @@ impl Generator {
         match result {
             Some(Ok(bytes)) => Ok(bytes),
             Some(Err(e)) => Err(ChunkError::Failed(e)),
-            None => Err(ChunkError::Failed("the generation job was dropped".into())),
+            None => Err(ChunkError::Failed(dropped.into())),
         }
     }
 
@@ -527,48 +550,18 @@ impl Generator {
     /// a cache). Unlike a chunk it is never refused for a full queue: the clients of tasks (3D
     /// Tiles viewers) do not ask again after a 503, they show a hole.
     pub async fn task(self: &Arc<Self>, priority: f64, task: impl FnOnce() + Send + 'static) -> Result<(), ChunkError> {
-        let priority = priority + 0.0;
-        let (mut rx, token) = {
-            let mut store = self.store();
-            let (tx, rx) = watch::channel(None);
-            let token = store.next_token;
-            store.next_token += 1;
-            let rank = Rank { priority, seq: token };
-            store.queue.insert(rank, token);
-            let done = move || {
-                let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(task));
-                let outcome = match ran {
-                    Ok(()) => Ok(Bytes::new()),
-                    Err(_) => Err(Arc::from("a task panicked; this is a bug in pmc")),
-                };
-                tx.send_replace(Some(outcome));
+        let (tx, rx) = watch::channel(None);
+        let done = move || {
+            let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(task));
+            let outcome = match ran {
+                Ok(()) => Ok(Bytes::new()),
+                Err(_) => Err(Arc::from("a task panicked; this is a bug in pmc")),
             };
-            store.jobs.insert(
-                token,
-                Job {
-                    id: None,
-                    rx: rx.clone(),
-                    waiters: 1,
-                    state: JobState::Queued {
-                        rank,
-                        work: Work::Task(Box::new(done)),
-                    },
-                },
-            );
-            let this = Arc::clone(self);
-            self.pool.spawn(move || this.work());
-            (rx, token)
+            tx.send_replace(Some(outcome));
         };
-        let _waiter = Waiter { generator: self, token };
-        let outcome = match rx.wait_for(Option::is_some).await {
-            Ok(r) => r.clone(),
-            Err(_) => None,
-        };
-        match outcome {
-            Some(Ok(_)) => Ok(()),
-            Some(Err(e)) => Err(ChunkError::Failed(e)),
-            None => Err(ChunkError::Failed("the task was dropped".into())),
-        }
+        let work = Work::Task(Box::new(done));
+        let token = self.enqueue(&mut self.store(), priority + 0.0, None, rx.clone(), work);
+        self.outcome(rx, token, "the task was dropped").await.map(drop)
     }
 
     /// Runs task `token` (a worker took it from the queue; it catches its own panic and hands

@@ -228,8 +228,6 @@ async fn made(state: &AppState, set: Arc<TileSet>, key: Key) -> Result<Option<By
         }
         let _unlist = Unlist(tiles, key, started.clone());
         let st = state.clone();
-        let out: Arc<Mutex<Option<Built>>> = Arc::default();
-        let slot = out.clone();
         let task = move || {
             started.store(true, Ordering::SeqCst);
             let made = if content {
@@ -244,8 +242,7 @@ async fn made(state: &AppState, set: Arc<TileSet>, key: Key) -> Result<Option<By
                 lock(&tiles.cache).insert(key, b.clone(), size as u64);
             }
             lock(&tiles.building).remove(&key);
-            let _ = tx.send(Some(built.clone()));
-            *lock(&slot) = Some(built);
+            let _ = tx.send(Some(built));
         };
         // (coarser tiles first: a client shows them before their children)
         let priority = -f64::from(t.level);
@@ -262,8 +259,10 @@ async fn made(state: &AppState, set: Arc<TileSet>, key: Key) -> Result<Option<By
             };
             return Err(ApiError::internal(format!("making the tile failed: {why}")));
         }
-        let built = lock(&out)
-            .take()
+        // (the task sent its file to every receiver, this request's too)
+        let built = rx
+            .borrow()
+            .clone()
             .unwrap_or_else(|| Err(Arc::from("the tile's task ended without a file")));
         return built.map_err(|e| ApiError::internal(e.to_string()));
     }

@@ -246,9 +246,8 @@ fn separate_caps(mesh: &mut ChunkMesh, centre: DVec3, origin: DVec3) {
         let c = *copy.entry(v).or_insert_with(|| {
             let i = v as usize;
             let from = above(mesh, v);
+            let p = position(mesh, i);
             let m = &mut *mesh;
-            let low = m.positions_low.get(i).copied().unwrap_or([0.0; 3]);
-            let p = DVec3::from(m.positions[i].map(f64::from)) + DVec3::from(low.map(f64::from));
             let up = (p + origin).normalize_or_zero();
             let d = p - centre;
             let out = d - up * d.dot(up);
