@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Runs every test of the project: formatting, lints, the Rust test suite, and the external checks
-# of exported planets (Khronos glTF validator, trimesh). Installs what it needs on a fresh machine.
+# Runs every test of the project: formatting, lints, the Rust test suite, the Python package (its
+# wheel built and tested with pytest), and the external checks of exported planets (Khronos glTF
+# validator, trimesh). Installs what it needs on a fresh machine.
 #
 #   ./scripts/test.sh           every test (what CI runs)
-#   ./scripts/test.sh --quick   the inner loop: formatting, lints, the viewer's unit tests and the
-#                               Rust suite; no exports, external validators or browser tests
+#   ./scripts/test.sh --quick   the inner loop: formatting, lints, the viewer's unit tests, the
+#                               Rust suite and the Python package; no exports, external validators
+#                               or browser tests
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,7 +14,7 @@ QUICK=0
 for arg in "$@"; do
   case "$arg" in
     --quick) QUICK=1 ;;
-    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
     *) echo "test.sh: unknown option $arg (--quick, --help)" >&2; exit 2 ;;
   esac
 done
@@ -31,6 +33,30 @@ fi
 if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 fi
+
+# Cargo's own CARGO_TARGET_DIR is followed (a build directory shared between checkouts keeps the
+# dependencies compiled).
+TARGET_DIR="${CARGO_TARGET_DIR:-target}"
+case "$TARGET_DIR" in /*) ;; *) TARGET_DIR="$PWD/$TARGET_DIR" ;; esac
+mkdir -p "$TARGET_DIR"
+
+# The Python package's virtual environment (maturin, numpy, pytest, dask, ...), made in the
+# background while the Rust code builds: mostly downloads. Debian's python3 needs python3-venv.
+if ! python3 -c "import ensurepip, venv" 2>/dev/null; then
+  if [ "$(id -u)" = 0 ]; then
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv
+  else
+    echo "the tests need Python's venv module: sudo apt-get install python3-venv" >&2
+    exit 1
+  fi
+fi
+VENV="$TARGET_DIR/python-venv"
+(
+  [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
+  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check -r python/requirements-test.txt
+) > "$TARGET_DIR/python-venv.log" 2>&1 &
+VENV_JOB=$!
 
 step "install the viewer's packages, CesiumJS, Chromium for its end-to-end tests, and the real Earth's data"
 if [ ! -d viewer/node_modules ]; then
@@ -75,10 +101,6 @@ step "viewer: build (embedded into pmc by the next step)"
 (cd viewer && npm run --silent build)
 
 step "cargo test"
-# Cargo's own CARGO_TARGET_DIR is followed (a build directory shared between checkouts keeps the
-# dependencies compiled).
-TARGET_DIR="${CARGO_TARGET_DIR:-target}"
-case "$TARGET_DIR" in /*) ;; *) TARGET_DIR="$PWD/$TARGET_DIR" ;; esac
 # The tests' scratch files (std::env::temp_dir) go to a directory of the build's, emptied at each
 # run, rather than piling up in /tmp run after run.
 SCRATCH="$TARGET_DIR/test-scratch"
@@ -93,10 +115,25 @@ TMPDIR="$SCRATCH" cargo test --workspace --exclude pmc-bench --locked 2>&1 | tee
 # compiles the workspace once, not a second time for a release build.
 PMC="$TARGET_DIR/debug/pmc"
 
+step "Python package: the wheel (maturin) and its tests (pytest, a 2-worker Dask bake among them)"
+if ! wait "$VENV_JOB"; then
+  cat "$TARGET_DIR/python-venv.log" >&2
+  echo "test.sh: the Python virtual environment could not be made (above)" >&2
+  exit 1
+fi
+# The development profile has the tests' settings (Cargo.toml), so the wheel's build reuses the
+# crates `cargo test` compiled.
+rm -rf "$TARGET_DIR/wheels"
+"$VENV/bin/maturin" build --quiet --locked --out "$TARGET_DIR/wheels" -m python/Cargo.toml
+"$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$TARGET_DIR"/wheels/pmc-*.whl
+# From another directory, so that `import pmc` is the installed wheel, not the source folder.
+(cd "$TARGET_DIR" && PMC_BIN="$PMC" TMPDIR="$SCRATCH" "$VENV/bin/python" -m pytest "$OLDPWD/python/tests" -q -p no:cacheprovider 2>&1) | tee "$TARGET_DIR/pytest.log"
+
 if [ "$QUICK" = 1 ]; then
   step "quick mode: exports, external validators and the end-to-end tests not run"
   VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
-  awk -v ext="${VITEST:-0}" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/cargo-test.log
+  PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' "$TARGET_DIR/pytest.log" | tail -1)
+  awk -v ext="$((${VITEST:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/cargo-test.log
   exit 0
 fi
 
@@ -135,4 +172,5 @@ step "all checks passed"
 EXTERNAL_CHECKS=5
 VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
-awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log
+PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' "$TARGET_DIR/pytest.log" | tail -1)
+awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log

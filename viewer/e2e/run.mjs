@@ -20,9 +20,10 @@
 //                   scenarios/gallery.mjs)
 //   PMC_E2E_SKY=1   the atmosphere on in every step (by default only step 12, the sky's, turns it
 //                   on: the software renderer draws it slowly)
-//   PMC_E2E_LANES=1 one step after the other (by default the flights, steps 10, 11 and 9,
-//                   CesiumJS's, step 19, and the 3D Tiles mode's, step 20, run in browsers of
-//                   their own beside the others; the soak, step 18, runs last and alone)
+//   PMC_E2E_LANES=1 one step after the other (by default CesiumJS's, step 19, the 3D Tiles
+//                   mode's, step 20, and the default planet's levels of detail, step 9, run in
+//                   browsers of their own beside the others; the soak, step 18, runs last and
+//                   alone)
 //   PMC_E2E_GL      llvmpipe or swiftshader: the software renderer of WebGL (by default Mesa's
 //                   llvmpipe where installed; the flights always draw with SwiftShader)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
@@ -76,12 +77,16 @@ const SCENARIOS = [pageLoads, planetDrawn, presetSwitch, newChunks, viewsAndMode
  */
 const REAL_SERVER_SCENARIOS = [pathAndNavGrid, editing, sky, imagery, overlays, levelSwitch, seaByData];
 /**
- * The flights over true-scale planets (the earth preset, an elevation model) and the default
- * planet's levels of detail, then the planet's 3D Tiles in CesiumJS and in the viewer's 3D Tiles
- * mode, each with servers of their own: in a browser of their own beside the others
- * (PMC_E2E_LANES, by default 2), the two lanes of about the same length.
+ * The flights over true-scale planets (the earth preset, an elevation model): after those, in the
+ * first lane's own browser for FLIGHTS_GL.
  */
-const SECOND_LANE = [lodEarth, elevationModel, lodDefault, cesiumTiles, tilesMode];
+const FIRST_LANE_FLIGHTS = [lodEarth, elevationModel];
+/**
+ * The planet's 3D Tiles in CesiumJS (the longest step) and in the viewer's 3D Tiles mode, then the
+ * default planet's levels of detail, each with servers of their own: in browsers of their own
+ * beside the first lane (PMC_E2E_LANES, by default 2), the two lanes of about the same length.
+ */
+const SECOND_LANE = [cesiumTiles, tilesMode, lodDefault];
 /** The steps whose pictures with back faces flagged are drawn by FLIGHTS_GL (harness.mjs). */
 const FLIGHTS = new Set([lodEarth, elevationModel, lodDefault]);
 /** Then, alone on the machine (it compares the times of its views): the soak. */
@@ -103,6 +108,20 @@ async function main() {
      */
     shared: { pageBase, orbitStats: null, orbitImg: null, closeup: null },
   };
+  // Each lane's browsers, one for each renderer its steps draw with, each opened when a step
+  // first needs it: their own pages, consoles and requests (the first lane's default one is t).
+  const lanes = [new Map([[GL, t]]), new Map()];
+  const browserFor = async (lane, gl) => {
+    const browsers = lanes[LANES < 2 ? 0 : lane];
+    if (!browsers.has(gl)) browsers.set(gl, { ...(await openBrowser(gl)), shared: t.shared });
+    return browsers.get(gl);
+  };
+  const runOn = async (lane, steps) => {
+    for (const s of steps.filter((s) => selected(s.name))) {
+      const on = await browserFor(lane, FLIGHTS.has(s) ? FLIGHTS_GL : GL);
+      await step(s.name, () => s.scenario(on));
+    }
+  };
   const firstLane = async () => {
     for (const s of SCENARIOS) await step(s.name, () => s.scenario(t));
     if (USE_MOCK) {
@@ -110,20 +129,10 @@ async function main() {
       return;
     }
     for (const s of REAL_SERVER_SCENARIOS) await step(s.name, () => s.scenario(t));
-  };
-  // The second lane's browsers, one for each renderer its steps draw with, each opened when a step
-  // first needs it: their own pages, consoles and requests.
-  const browsers = new Map();
-  const browserFor = async (gl) => {
-    if (!browsers.has(gl)) browsers.set(gl, LANES < 2 && gl === GL ? t : { ...(await openBrowser(gl)), shared: t.shared });
-    return browsers.get(gl);
+    await runOn(0, FIRST_LANE_FLIGHTS);
   };
   const secondLane = async () => {
-    if (USE_MOCK) return;
-    for (const s of SECOND_LANE.filter((s) => selected(s.name))) {
-      const on = await browserFor(FLIGHTS.has(s) ? FLIGHTS_GL : GL);
-      await step(s.name, () => s.scenario(on));
-    }
+    if (!USE_MOCK) await runOn(1, SECOND_LANE);
   };
   if (LANES >= 2 && !USE_MOCK && SECOND_LANE.some((s) => selected(s.name))) {
     await Promise.all([firstLane(), secondLane()]);

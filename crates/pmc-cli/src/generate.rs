@@ -49,9 +49,6 @@ pub struct GenerateArgs {
     quiet: bool,
 }
 
-/// Most chunks a `--region` export may hold.
-const REGION_BUDGET: usize = 200_000;
-
 /// Parses `--region LAT,LON,RADIUS_M` (of `pmc generate` and `pmc tiles bake`).
 pub(crate) fn parse_region(s: &str) -> Result<(f64, f64, f64), CliError> {
     let err = |why: String| CliError::Region(format!("{s}: {why}; give LAT,LON,RADIUS_M (degrees, degrees, metres)"));
@@ -120,7 +117,7 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
                 .to_unit();
             // Centred on the ground there, so the region holds the surface around the place.
             let centre = dir * planet.surface_radius(dir);
-            let keys = pmc_lod::region_chunks(&planet, centre, radius, level, REGION_BUDGET)
+            let keys = pmc_lod::region_chunks(&planet, centre, radius, level, pmc_lod::REGION_BUDGET)
                 .map_err(|e| CliError::Region(e.to_string()))?;
             if !args.quiet {
                 eprintln!(

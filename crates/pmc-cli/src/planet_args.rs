@@ -10,7 +10,7 @@ use crate::error::CliError;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, Command, FromArgMatches};
 use pmc_geometry::Layout;
-use pmc_planet::{DemSpec, Interpolation, Planet, PresetKind, TerrainSpec};
+use pmc_planet::{Interpolation, LayoutChoice, Planet, PresetKind, TerrainError, TerrainSpec};
 
 /// The ids of the five layout options, in the order of [`Layout::new`]'s parameters.
 const LAYOUT_IDS: [&str; 5] = ["n_c", "n_t", "d_b", "l_d", "d_c"];
@@ -174,23 +174,25 @@ impl PlanetArgs {
     /// for `--radius`, or the terrain's own layout (the preset's, or the one for an elevation
     /// model's body radius) with each typed layout option replacing its parameter.
     pub fn layout_for(&self, terrain: &TerrainSpec) -> Result<Layout, CliError> {
-        if let Some(r) = self.radius {
-            if self.dem.is_some() {
-                return Err(CliError::Dem(
-                    "--radius does not apply to --dem: the elevation file gives the body's radius".into(),
-                ));
-            }
-            return Ok(self.preset.default_layout(Some(r))?);
+        if self.radius.is_some() && self.dem.is_some() {
+            return Err(CliError::Dem(
+                "--radius does not apply to --dem: the elevation file gives the body's radius".into(),
+            ));
         }
-        let base = pmc_planet::default_layout(terrain).map_err(|e| CliError::Dem(e.to_string()))?;
-        let pick = |i: usize| self.typed[i];
-        Ok(Layout::new(
-            if pick(0) { self.n_c } else { base.n_c() },
-            if pick(1) { self.n_t } else { base.n_t() },
-            if pick(2) { self.d_b } else { base.d_b() },
-            if pick(3) { self.l_d } else { base.l_d() },
-            if pick(4) { self.d_c } else { base.d_c() },
-        )?)
+        let typed = |i: usize| self.typed[i];
+        let choice = LayoutChoice {
+            radius: self.radius,
+            n_c: typed(0).then_some(self.n_c),
+            n_t: typed(1).then_some(self.n_t),
+            d_b: typed(2).then_some(self.d_b),
+            l_d: typed(3).then_some(self.l_d),
+            d_c: typed(4).then_some(self.d_c),
+        };
+        choice.resolve(terrain).map_err(|e| match e {
+            TerrainError::Radius(r) => CliError::from(r),
+            TerrainError::Layout(l) => CliError::from(l),
+            e => CliError::Dem(e.to_string()),
+        })
     }
 
     /// Builds the planet.
@@ -201,27 +203,13 @@ impl PlanetArgs {
     }
 }
 
-/// The terrain of the elevation file at `path`: its digest read from the file, the path made
-/// absolute.
+/// The terrain of the elevation file at `path` ([`pmc_planet::dem_terrain`]).
 pub(crate) fn dem_terrain(
     path: &std::path::Path,
     interpolation: Interpolation,
     seed: u64,
 ) -> Result<TerrainSpec, CliError> {
-    let dem = pmc_dem::CubeDem::open(path).map_err(|e| CliError::Dem(e.to_string()))?;
-    let abs = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    let text = abs.to_str().ok_or_else(|| {
-        CliError::Dem(format!(
-            "{}: the path is not valid UTF-8; rename the file",
-            path.display()
-        ))
-    })?;
-    Ok(TerrainSpec::Dem(DemSpec {
-        path: text.to_string(),
-        digest: dem.digest().to_string(),
-        interpolation,
-        seed,
-    }))
+    pmc_planet::dem_terrain(path, interpolation, seed).map_err(|e| CliError::Dem(e.to_string()))
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use crate::work;
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pmc_tiles::bake::BakeStats;
-use pmc_tiles::{FrameChoice, Region, TileOptions, TileSet};
+use pmc_tiles::{FrameChoice, Region, TileOptions};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -111,7 +111,6 @@ fn bake(args: &BakeArgs) -> Result<(), CliError> {
         None => (args.planet.planet()?, None),
     };
     let region = args.region.as_deref().map(parse_region).transpose()?;
-    let frame = FrameChoice::from(args.frame).frame(planet.datum_radius());
     let pool = work::thread_pool(args.threads)?;
     let extras = pmc_tiles::planet_extras(&planet, edits);
     let planet = Arc::new(planet);
@@ -123,14 +122,12 @@ fn bake(args: &BakeArgs) -> Result<(), CliError> {
         }
     };
     say("measuring the geometric error of each level of detail");
-    let errors = pool.install(|| pmc_lod::measure_level_errors(&planet, 1024, 0x5eed));
     let options = TileOptions {
         max_level: args.max_level,
         min_level: args.min_level,
         region,
     };
-    let generator = format!("pmc {}", env!("CARGO_PKG_VERSION"));
-    let tiles = TileSet::new(planet, errors, frame, options, &generator)?;
+    let tiles = pool.install(|| pmc_tiles::bake::tile_set(planet, FrameChoice::from(args.frame), options))?;
     let bar = if quiet {
         ProgressBar::hidden()
     } else {

@@ -123,6 +123,85 @@ impl EquirectDem {
     }
 }
 
+impl EquirectDem {
+    /// A grid of heights held in memory: an array another program read (any GDAL format through
+    /// rasterio, netCDF4 or Zarr through xarray), `width` columns by `height` rows, row by row
+    /// from the **north** (the order of images and of most rasters) when `north_first`, else from
+    /// the south. `extent` places it as it places a PNG's pixels (only its bounds and
+    /// `cell_centres` are used: heights are in metres). Heights equal to `nodata`, and those that
+    /// are not finite, are missing. `name` names the grid in errors and in the import's report.
+    ///
+    /// Errors: [`DemError::InvalidExtent`] (also when `heights` does not hold `width * height`
+    /// values), [`DemError::AxisInvalid`] (one column or row of nodes), [`DemError::TooLarge`],
+    /// [`DemError::NoValidData`].
+    pub fn from_heights(
+        name: &str,
+        width: usize,
+        height: usize,
+        north_first: bool,
+        heights: &[f32],
+        extent: &PngExtent,
+        nodata: Option<f32>,
+    ) -> Result<EquirectDem, DemError> {
+        check_extent(name, extent)?;
+        if width == 0 || height == 0 || heights.len() as u64 != (width as u64).saturating_mul(height as u64) {
+            return Err(DemError::InvalidExtent {
+                file: name.to_owned(),
+                detail: format!(
+                    "the grid is {width} x {height} but holds {} heights; give a 2-D array of rows",
+                    heights.len()
+                ),
+            });
+        }
+        if (width as u64).saturating_mul(height as u64) > MAX_CELLS {
+            return Err(DemError::TooLarge {
+                file: name.to_owned(),
+                width: width as u64,
+                height: height as u64,
+                limit: MAX_CELLS,
+            });
+        }
+        let lon_label = "longitude (array columns)";
+        let lat_label = "latitude (array rows)";
+        let lon = axis::longitudes(
+            positions(name, lon_label, extent.west, extent.east, width, extent.cell_centres)?,
+            width,
+        )
+        .map_err(|p| read::axis_error(name, lon_label, p))?;
+        let lat = positions(name, lat_label, extent.south, extent.north, height, extent.cell_centres)?;
+        let mut out = Vec::with_capacity(lon.width * height);
+        for r in 0..height {
+            let src = if north_first { height - 1 - r } else { r };
+            let row = &heights[src * width..][..width];
+            out.extend(row[..lon.width].iter().map(|&v| {
+                if Some(v) == nodata || !v.is_finite() {
+                    f32::NAN
+                } else {
+                    v
+                }
+            }));
+        }
+        if out.iter().all(|v| v.is_nan()) {
+            return Err(DemError::NoValidData {
+                file: name.to_owned(),
+                variable: "heights".to_owned(),
+            });
+        }
+        Ok(EquirectDem {
+            source: name.to_owned(),
+            variable: "heights".to_owned(),
+            width: lon.width,
+            height,
+            lon_first: lon.first,
+            lon_step: lon.step,
+            lat_first: lat.first,
+            lat_step: lat.step,
+            wraps: lon.wraps,
+            heights: out,
+        })
+    }
+}
+
 fn check_extent(file: &str, extent: &PngExtent) -> Result<(), DemError> {
     match extent.problem() {
         Some(detail) => Err(DemError::InvalidExtent {

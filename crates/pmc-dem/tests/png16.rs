@@ -265,3 +265,58 @@ fn crc32(bytes: &[u8]) -> u32 {
     }
     !crc
 }
+
+/// A grid of heights from memory (the Python package's `pmc.dem.import_array`): the same grid as
+/// the PNG's, rows given from the north or from the south, gives the same heights as the PNG.
+#[test]
+fn heights_from_memory_match_the_same_grid_read_from_a_png() {
+    let (w, h, u, bytes) = etopo_png();
+    let extent = PngExtent {
+        west: 20.0,
+        south: -90.0,
+        east: 380.0,
+        north: 90.0,
+        scale: 1.0,
+        offset: -11_000.0,
+        nodata: None,
+        cell_centres: true,
+    };
+    let png = EquirectDem::from_png16_bytes("etopo.png", &bytes, &extent).unwrap();
+    let north_first: Vec<f32> = u.iter().map(|&v| f32::from(v) - 11_000.0).collect();
+    let a = EquirectDem::from_heights("grid", w, h, true, &north_first, &extent, None).unwrap();
+    let south_first: Vec<f32> = north_first.chunks(w).rev().flatten().copied().collect();
+    let b = EquirectDem::from_heights("grid", w, h, false, &south_first, &extent, None).unwrap();
+    for dem in [&a, &b] {
+        assert_eq!((dem.width(), dem.height()), (png.width(), png.height()));
+        assert_eq!(dem.heights(), png.heights());
+        assert_eq!((dem.lon_first(), dem.lat_first()), (png.lon_first(), png.lat_first()));
+    }
+    assert_eq!(a.source(), "grid");
+}
+
+#[test]
+fn heights_from_memory_mark_nodata_and_refuse_bad_grids() {
+    let extent = PngExtent::global(1.0, 0.0);
+    let mut v = vec![100.0f32; 8 * 4];
+    v[3] = -9999.0;
+    v[5] = f32::INFINITY;
+    let dem = EquirectDem::from_heights("g", 8, 4, true, &v, &extent, Some(-9999.0)).unwrap();
+    assert_eq!(dem.heights().iter().filter(|h| h.is_nan()).count(), 2);
+    let short = EquirectDem::from_heights("g", 8, 4, true, &v[..31], &extent, None).unwrap_err();
+    assert!(
+        matches!(short, DemError::InvalidExtent { .. }) && short.to_string().contains("holds 31"),
+        "{short}"
+    );
+    let none = EquirectDem::from_heights("g", 8, 4, true, &[f32::NAN; 32], &extent, None).unwrap_err();
+    assert!(matches!(none, DemError::NoValidData { .. }), "{none}");
+    let bad = PngExtent {
+        west: 10.0,
+        east: 0.0,
+        ..extent
+    };
+    let e = EquirectDem::from_heights("g", 8, 4, true, &v, &bad, None).unwrap_err();
+    assert!(
+        e.to_string().starts_with("g: ") && e.to_string().contains("west"),
+        "{e}"
+    );
+}

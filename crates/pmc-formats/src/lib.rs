@@ -51,3 +51,4 @@ pub use glb::{write_glb, write_tile_glb};
 pub use meta::ExportMeta;
 pub use obj::write_obj;
 pub use ply::{write_ply, PLY_FACE_BYTES, PLY_VERTEX_BYTES};
+pub use weld::{weld_arrays, WeldedArrays};

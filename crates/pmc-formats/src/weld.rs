@@ -116,6 +116,62 @@ pub(crate) fn weld(meshes: &[Checked<'_>]) -> Result<Welded, ExportError> {
     Ok(out)
 }
 
+/// Chunk meshes welded into one indexed mesh with every vertex attribute, in f64 world space:
+/// what OBJ and PLY exports write, as arrays (the Python package's regions).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WeldedArrays {
+    /// World positions, metres, planet-centred.
+    pub positions: Vec<[f64; 3]>,
+    /// Unit outward normals.
+    pub normals: Vec<[f32; 3]>,
+    /// Linear RGBA colours (all 0 where the meshes carry none).
+    pub colors: Vec<[u8; 4]>,
+    /// Heights above the datum, metres.
+    pub heights: Vec<f32>,
+    /// Depths of sea water above the vertex, metres.
+    pub water_depths: Vec<f32>,
+    /// Material ids.
+    pub materials: Vec<u8>,
+    /// Triangles, winding kept.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Welds `meshes` by their canonical vertex identity (see the module's documentation): each
+/// welded vertex takes its attributes from its first use; collapsed triangles are dropped.
+/// Errors as the welded exports: a mesh that fails its checks, or more than 2^32 - 1 vertices.
+pub fn weld_arrays(meshes: &[ChunkMesh]) -> Result<WeldedArrays, ExportError> {
+    let checked = check_meshes(meshes)?;
+    let welded = weld(&checked)?;
+    let n = welded.sources.len();
+    let mut out = WeldedArrays {
+        positions: Vec::with_capacity(n),
+        normals: Vec::with_capacity(n),
+        colors: Vec::with_capacity(n),
+        heights: Vec::with_capacity(n),
+        water_depths: Vec::with_capacity(n),
+        materials: Vec::with_capacity(n),
+        triangles: welded.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+    };
+    for &(mi, vi) in &welded.sources {
+        let c = &checked[mi as usize];
+        let (m, v) = (c.mesh, vi as usize);
+        out.positions.push(m.world_position_full(v).to_array());
+        out.normals.push(m.normals[v]);
+        if c.attributes {
+            out.colors.push(m.colors[v]);
+            out.heights.push(m.heights[v]);
+            out.water_depths.push(m.water_depths[v]);
+            out.materials.push(m.materials[v]);
+        } else {
+            out.colors.push([0; 4]);
+            out.heights.push(0.0);
+            out.water_depths.push(0.0);
+            out.materials.push(0);
+        }
+    }
+    Ok(out)
+}
+
 /// Removes vertices only collapsed triangles used, keeping the order of the others.
 fn drop_unused(w: &mut Welded) {
     let mut remap = vec![u32::MAX; w.sources.len()];
@@ -152,6 +208,25 @@ mod tests {
             edge_keys: keys.iter().map(|&k| EdgeKey(k, k + 1)).collect(),
             ..Default::default()
         }
+    }
+
+    #[test]
+    fn welded_arrays_carry_the_first_use_of_each_vertex() {
+        let mut a = mesh(&[1, 2, 3], &[0, 1, 2]);
+        let mut b = mesh(&[3, 2, 4], &[1, 0, 2]);
+        for (m, base) in [(&mut a, 0u8), (&mut b, 10)] {
+            m.origin = pmc_geometry::glam::DVec3::new(1e6, 0.0, 0.0);
+            m.heights = vec![1.0, 2.0, 3.0];
+            m.water_depths = vec![0.0; 3];
+            m.colors = vec![[base, 0, 0, 255]; 3];
+            m.materials = vec![base; 3];
+        }
+        let w = weld_arrays(&[a, b]).unwrap();
+        assert_eq!(w.positions.len(), 4);
+        assert_eq!(w.triangles, vec![[0, 1, 2], [1, 2, 3]]);
+        assert_eq!(w.positions[0], [1e6, 0.0, 0.0]);
+        assert_eq!(w.materials, vec![0, 0, 0, 10]);
+        assert_eq!(w.heights, vec![1.0, 2.0, 3.0, 3.0]);
     }
 
     #[test]

@@ -11,6 +11,11 @@ pub const MAX_AXIS_TILES: u64 = 1 << 24;
 /// Largest number of tiles per chunk axis (`n_t`): bounds the memory of one chunk.
 pub const MAX_CHUNK_TILES: u32 = 128;
 
+/// Indices that name no chunk of a layout ([`Layout::chunk_key`]); the message says which.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct NotAChunk(pub String);
+
 /// Why a set of layout parameters was refused. Each variant says which parameter to change.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LayoutError {
@@ -203,6 +208,32 @@ impl Layout {
             && key.k < self.depth_chunks(key.level)
     }
 
+    /// The chunk `face/level/i/j/k` of this layout, from indices given from outside (a request,
+    /// a script): [`NotAChunk`] saying which index is out of range otherwise.
+    pub fn chunk_key(&self, face: Face, level: u64, i: u64, j: u64, k: u64) -> Result<ChunkKey, NotAChunk> {
+        let shown = format!("{}/{level}/{i}/{j}/{k}", face.name());
+        let max_level = self.max_level();
+        if level > u64::from(max_level) {
+            return Err(NotAChunk(format!(
+                "chunk {shown} is not part of this planet: level {level} is above the layout's max level {max_level}"
+            )));
+        }
+        let level = level as u8;
+        let (n, d) = (self.chunks_per_side(level), self.depth_chunks(level));
+        let key = match (u32::try_from(i), u32::try_from(j), u32::try_from(k)) {
+            (Ok(i), Ok(j), Ok(k)) if i < n && j < n && k < d => ChunkKey { face, level, i, j, k },
+            _ => {
+                return Err(NotAChunk(format!(
+                "chunk {shown} is not part of this planet: at level {level}, i and j must be below {n} and k below {d}"
+            )))
+            }
+        };
+        if !self.contains_chunk(&key) {
+            return Err(NotAChunk(format!("chunk {shown} is not part of this planet")));
+        }
+        Ok(key)
+    }
+
     /// The chunk of `level` one step beyond `side` of `key`, or `None` past the shell's inner or
     /// outer boundary (or when `key` is not a chunk of this layout, or `level` too coarse).
     ///
@@ -343,6 +374,23 @@ mod tests {
     use super::*;
     use crate::face_conversion::FaceTransition;
     use proptest::prelude::*;
+
+    #[test]
+    fn chunk_keys_from_outside_are_checked() {
+        let l = Layout::new(4, 16, 100.0, 2.0, 3).unwrap();
+        let k = l.chunk_key(Face::ALL[2], 1, 1, 0, 1).unwrap();
+        assert_eq!((k.level, k.i, k.j, k.k), (1, 1, 0, 1));
+        assert!(l.contains_chunk(&k));
+        for (level, i, j, kk, needle) in [
+            (3, 0, 0, 0, "above the layout's max level 2"),
+            (0, 4, 0, 0, "i and j must be below 4 and k below 3"),
+            (1, 0, 0, 2, "i and j must be below 2 and k below 2"),
+            (0, 0, u64::MAX, 0, "is not part of this planet"),
+        ] {
+            let e = l.chunk_key(Face::ALL[0], level, i, j, kk).unwrap_err().to_string();
+            assert!(e.contains(needle) && e.contains("is not part of this planet"), "{e}");
+        }
+    }
 
     #[test]
     fn formulas_match_the_paper() {

@@ -42,4 +42,4 @@ pub use face_conversion::{convert_axis, AxisMap, FaceTransition};
 pub use glam;
 pub use keys::{ChunkKey, ChunkKeyParseError, ChunkSide, EdgeKey, SideMask, VoxelKey};
 pub use latlon::{LatLon, LatLonError, Place, PlaceParseError};
-pub use layout::{face_lattice, FaceGrid, Layout, LayoutError, MAX_AXIS_TILES, MAX_CHUNK_TILES};
+pub use layout::{face_lattice, FaceGrid, Layout, LayoutError, NotAChunk, MAX_AXIS_TILES, MAX_CHUNK_TILES};

@@ -110,5 +110,5 @@ pub use adjacency::{adjacent, OFFSETS};
 pub use cull::{frustum_planes, occluder_radius, sphere_below_horizon, sphere_in_frustum};
 pub use errors::{measure_level_errors, CELLS_PER_CHUNK, MIN_GRADIENT};
 pub use radii::{planet_radii, ChunkRadii, PatchRadii, MAX_KEPT_RADII, WIDE_PATCH};
-pub use region::{level_for_error, region_chunks, RegionError};
+pub use region::{level_for_error, region_chunks, RegionError, REGION_BUDGET};
 pub use select::{LodError, LodParams, Selected, Selection, Selector, View, DEFAULT_MAX_CHUNKS, MAX_KEPT_CAPS};

@@ -12,6 +12,10 @@ use pmc_geometry::glam::DVec3;
 use pmc_geometry::ChunkKey;
 use pmc_planet::Planet;
 
+/// The most chunks a region export may hold (`pmc generate --region`, the Python package's
+/// `Planet.region`): the `budget` front ends give [`region_chunks`].
+pub const REGION_BUDGET: usize = 200_000;
+
 /// Why a region cannot be exported.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RegionError {

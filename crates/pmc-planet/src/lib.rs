@@ -24,6 +24,7 @@
 mod cache;
 pub mod heightfield;
 mod planet;
+mod spec;
 mod terrain;
 
 pub use cache::BaseCacheStats;
@@ -31,4 +32,5 @@ pub use planet::{ChunkScratch, Planet};
 pub use pmc_density::presets::{PresetKind, Terrain, UnknownPreset};
 pub use pmc_density::terrain::{DemSpec, Interpolation, TerrainSpec};
 pub use pmc_edit;
+pub use spec::{dem_terrain, LayoutChoice};
 pub use terrain::{build_terrain, default_layout, TerrainError};

@@ -40,6 +40,18 @@ pub enum TerrainError {
         #[source]
         source: ReliefError,
     },
+    /// A planet radius out of range.
+    #[error(transparent)]
+    Radius(#[from] pmc_density::presets::RadiusError),
+    /// A radius was given with layout parameters: the radius picks the whole layout.
+    #[error("a planet radius picks the whole layout: give either the radius or the layout parameters (n_c, n_t, d_b, l_d, d_c), not both")]
+    RadiusWithLayout,
+    /// A radius was given for an elevation model, whose file gives the body's radius.
+    #[error("a radius does not apply to an elevation model: the elevation file gives the body's radius")]
+    RadiusWithDem,
+    /// A file path that is not valid UTF-8 (a planet records its elevation file's path as text).
+    #[error("{0}: the path is not valid UTF-8; rename the file")]
+    PathNotUtf8(String),
 }
 
 /// The terrain `spec` describes, built for `layout`. Presets never fail; an elevation model is

@@ -207,27 +207,9 @@ pub(crate) fn chunk_key(
         index_part("j", j)?,
         index_part("k", k)?,
     );
-    let max_level = layout.max_level();
-    let shown = format!("{}/{level}/{i}/{j}/{k}", face.name());
-    if level > u64::from(max_level) {
-        return Err(ApiError::not_found(format!(
-            "chunk {shown} is not part of this planet: level {level} is above the layout's max level {max_level}"
-        )));
-    }
-    let level = level as u8;
-    let (n, d) = (layout.chunks_per_side(level), layout.depth_chunks(level));
-    let key = match (u32::try_from(i), u32::try_from(j), u32::try_from(k)) {
-        (Ok(i), Ok(j), Ok(k)) if i < n && j < n && k < d => ChunkKey { face, level, i, j, k },
-        _ => {
-            return Err(ApiError::not_found(format!(
-                "chunk {shown} is not part of this planet: at level {level}, i and j must be below {n} and k below {d}"
-            )))
-        }
-    };
-    if !layout.contains_chunk(&key) {
-        return Err(ApiError::not_found(format!("chunk {shown} is not part of this planet")));
-    }
-    Ok(key)
+    layout
+        .chunk_key(face, level, i, j, k)
+        .map_err(|e| ApiError::not_found(e.0))
 }
 
 /// The answer to a chunk the generator could not serve.

@@ -9,12 +9,14 @@
 //! a bake never killed. Subtrees are baked depth first, a few at a time, each meshing its tiles
 //! on every core, so memory stays bounded at any depth.
 
-use crate::{TileCoord, TileSet, TilesError};
+use crate::{FrameChoice, TileCoord, TileOptions, TileSet, TilesError};
 use pmc_geometry::Face;
+use pmc_planet::Planet;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// Per tile level: tiles with content, and their bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -100,18 +102,7 @@ pub fn bake(
     progress: &(dyn Fn(&BakeStats) + Sync),
 ) -> Result<BakeStats, TilesError> {
     std::fs::create_dir_all(out).map_err(io(out))?;
-    let manifest = json!({
-        "format": "pmc-tiles-bake",
-        "version": 1,
-        "tiles": "tiles-v1",
-        "frame": tiles.frame().name(),
-        "availableLevels": tiles.available_levels(),
-        "options": {
-            "minLevel": tiles.options.min_level,
-            "region": tiles.options.region.map(|r| json!([r.lat, r.lon, r.radius])),
-        },
-        "planet": extras,
-    });
+    let manifest = manifest(tiles, extras.clone());
     let manifest_path = out.join("bake.json");
     match std::fs::read(&manifest_path) {
         Ok(bytes) => {
@@ -148,21 +139,13 @@ pub fn bake(
         partial: partial.clone(),
         next: AtomicU64::new(0),
     };
-    folder.write(
-        "bake.json",
-        &serde_json::to_vec_pretty(&manifest).expect("JSON serialises"),
-    )?;
+    folder.write("bake.json", &json_bytes(&manifest))?;
 
     let mut stats = BakeStats {
         levels: vec![LevelStats::default(); usize::from(tiles.available_levels())],
         ..BakeStats::default()
     };
-    let mut stack: Vec<TileCoord> = Face::ALL
-        .into_iter()
-        .rev()
-        .map(TileCoord::root)
-        .filter(|t| tiles.available(t))
-        .collect();
+    let mut stack: Vec<TileCoord> = roots(tiles).into_iter().rev().collect();
     let batch = (2 * rayon::current_num_threads()).max(2);
     while !stack.is_empty() {
         let take = stack.len().min(batch);
@@ -188,13 +171,106 @@ pub fn bake(
         stack.extend(children.into_iter().rev());
         progress(&stats);
     }
-    let tileset = tiles.tileset_json("", extras);
-    folder.write(
-        "tileset.json",
-        &serde_json::to_vec_pretty(&tileset).expect("JSON serialises"),
-    )?;
+    folder.write("tileset.json", &tileset_bytes(tiles, extras))?;
     std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
     Ok(stats)
+}
+
+/// The text of `generator` in a bake's tileset (`asset.generator`): `pmc` and its version.
+pub fn generator() -> String {
+    format!("pmc {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// The tile set a bake of `planet` writes: the geometric error of each level measured as every
+/// bake measures it (`pmc_lod::measure_level_errors`, 1024 samples, a fixed seed), the frame
+/// chosen for the planet's datum radius. Run it inside the thread pool that should measure.
+pub fn tile_set(planet: Arc<Planet>, frame: FrameChoice, options: TileOptions) -> Result<TileSet, TilesError> {
+    let errors = pmc_lod::measure_level_errors(&planet, 1024, 0x5eed);
+    let frame = frame.frame(planet.datum_radius());
+    TileSet::new(planet, errors, frame, options, &generator())
+}
+
+/// The manifest of a bake (`bake.json`): what was baked, so that a bake resumed into a folder is
+/// the same one.
+pub fn manifest(tiles: &TileSet, extras: Value) -> Value {
+    json!({
+        "format": "pmc-tiles-bake",
+        "version": 1,
+        "tiles": "tiles-v1",
+        "frame": tiles.frame().name(),
+        "availableLevels": tiles.available_levels(),
+        "options": {
+            "minLevel": tiles.options.min_level,
+            "region": tiles.options.region.map(|r| json!([r.lat, r.lon, r.radius])),
+        },
+        "planet": extras,
+    })
+}
+
+/// A JSON document as a bake writes it (pretty-printed).
+pub fn json_bytes(v: &Value) -> Vec<u8> {
+    serde_json::to_vec_pretty(v).expect("JSON serialises")
+}
+
+/// The bytes of a bake's `tileset.json`.
+pub fn tileset_bytes(tiles: &TileSet, extras: Value) -> Vec<u8> {
+    json_bytes(&tiles.tileset_json("", extras))
+}
+
+/// The subtree roots a bake starts from: the root tile of each face that has tiles, in face
+/// order.
+pub fn roots(tiles: &TileSet) -> Vec<TileCoord> {
+    Face::ALL
+        .into_iter()
+        .map(TileCoord::root)
+        .filter(|t| tiles.available(t))
+        .collect()
+}
+
+/// One file of a subtree's bake.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BakeFile {
+    /// Its path in the folder, `/`-separated.
+    pub path: String,
+    /// The tile level of a content file; `None` for the subtree file.
+    pub level: Option<u8>,
+    /// Its bytes.
+    pub bytes: Vec<u8>,
+}
+
+/// What baking one subtree writes, and the subtrees below it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SubtreeFiles {
+    /// The subtree's tile contents, then its subtree file (the order a bake writes them in: a
+    /// subtree file found in the folder means its contents are there too).
+    pub files: Vec<BakeFile>,
+    /// The roots of its child subtrees that hold tiles.
+    pub children: Vec<TileCoord>,
+}
+
+/// Bakes the subtree rooted at `root` in memory: the unit of work of a bake, in one process or
+/// spread over many (the Python package's distributed bake). The same root gives the same
+/// bytes wherever it is baked.
+pub fn subtree_files(tiles: &TileSet, root: TileCoord) -> Result<SubtreeFiles, TilesError> {
+    let built = tiles.build_subtree(root)?;
+    let mut files: Vec<BakeFile> = built
+        .contents
+        .into_iter()
+        .map(|(t, bytes)| BakeFile {
+            path: content_path(&t),
+            level: Some(t.level),
+            bytes,
+        })
+        .collect();
+    files.push(BakeFile {
+        path: subtree_path(&root),
+        level: None,
+        bytes: built.subtree,
+    });
+    Ok(SubtreeFiles {
+        files,
+        children: built.children,
+    })
 }
 
 /// One subtree's bake: what was written (per level, and the subtree file's bytes), or `None`
@@ -212,17 +288,22 @@ fn bake_one(tiles: &TileSet, folder: &Folder, root: TileCoord) -> Result<Done, T
             children: tiles.child_subtrees(root),
         });
     }
-    let built = tiles.build_subtree(root)?;
+    let files = subtree_files(tiles, root)?;
     let mut levels = vec![LevelStats::default(); usize::from(tiles.available_levels())];
-    for (t, bytes) in &built.contents {
-        folder.write(&content_path(t), bytes)?;
-        let l = &mut levels[usize::from(t.level)];
-        l.tiles += 1;
-        l.bytes += bytes.len() as u64;
+    let mut subtree_bytes = 0;
+    for f in &files.files {
+        folder.write(&f.path, &f.bytes)?;
+        match f.level {
+            Some(level) => {
+                let l = &mut levels[usize::from(level)];
+                l.tiles += 1;
+                l.bytes += f.bytes.len() as u64;
+            }
+            None => subtree_bytes = f.bytes.len() as u64,
+        }
     }
-    folder.write(&rel, &built.subtree)?;
     Ok(Done {
-        written: Some((levels, built.subtree.len() as u64)),
-        children: built.children,
+        written: Some((levels, subtree_bytes)),
+        children: files.children,
     })
 }
