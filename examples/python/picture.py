@@ -25,7 +25,7 @@ place = float(lat[i]), float(lon[i])
 print(f"the highest sampled ground: {heights[i]:.0f} m at {place}")
 
 # %%
-region = planet.region(place[0], place[1], 1200.0, level=0)
+region = planet.region(place[0], place[1], 500.0, level=0)
 mesh = region.to_pyvista()
 print(region, f"from {region.chunks} chunks")
 
@@ -39,7 +39,7 @@ up = centre / np.linalg.norm(centre)
 east = np.cross([0.0, 1.0, 0.0], up)
 east /= np.linalg.norm(east)
 north = np.cross(up, east)
-plotter.camera_position = [tuple(centre + 900 * up - 1500 * north + 600 * east), tuple(centre), tuple(up)]
+plotter.camera_position = [tuple(centre + 420 * up - 700 * north + 250 * east), tuple(centre), tuple(up)]
 out = sys.argv[1] if len(sys.argv) > 1 else "python-pyvista.png"
 plotter.screenshot(out)
 print("wrote", out)

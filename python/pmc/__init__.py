@@ -42,7 +42,8 @@ FaceLike = Union[int, str]
 
 
 class Planet:
-    """A planet: a terrain on a layout of chunks (seed 000's cube-to-sphere grid).
+    """A planet: a terrain on a layout of chunks (six cube faces mapped onto a sphere, each a grid
+    of chunks with an outward depth axis).
 
     ``Planet(preset="earthlike", seed=7)`` makes a procedural planet: ``sphere``,
     ``earthlike``, ``moon``, ``mars`` or ``earth`` (the Earth at true scale, 6 371 km with

@@ -807,12 +807,21 @@ impl PyTileBake {
 }
 
 impl PyTileBake {
+    /// The subtree root `(face, level, x, y, z)` of this bake, checked.
     fn coord(&self, (face, level, x, y, z): Root) -> PyResult<TileCoord> {
         let face = Face::ALL
             .get(usize::from(face))
             .copied()
             .ok_or_else(|| err(format!("face {face} is not a cube face (0 to 5)")))?;
         let t = TileCoord { face, level, x, y, z };
+        if level % pmc_tiles::SUBTREE_LEVELS != 0 {
+            return Err(err(format!(
+                "tile {}/{} is no subtree root: their levels are multiples of {}",
+                face.name(),
+                t.path(),
+                pmc_tiles::SUBTREE_LEVELS
+            )));
+        }
         if !self.tiles.available(&t) {
             return Err(err(format!(
                 "tile {}/{} is not a tile of this bake",

@@ -54,6 +54,11 @@ def test_two_workers_bake_the_same_bytes_as_the_command_line(reference, dask_cli
     assert len(dask_client.scheduler_info()["workers"]) == 2
 
 
+def test_an_fsspec_url_is_an_output_like_a_folder(reference, dask_client, tmp_path):
+    bake(f"file://{tmp_path}/tiles", dask_client)
+    assert tree(tmp_path / "tiles") == reference
+
+
 def test_a_worker_killed_mid_bake_changes_no_byte(reference, dask_client, tmp_path):
     killed = []
 
@@ -124,6 +129,31 @@ def test_a_worker_without_the_elevation_file_fails_the_bake(dask_client, tmp_pat
     assert not (out / "tileset.json").exists()
 
 
+def test_workers_fetch_the_elevation_file_from_its_url(dask_client, tmp_path, pmc_bin):
+    """The client's path is not the workers': they fetch the file from `dem_url` (any fsspec
+    URL), checked by its digest, and bake the same bytes as `pmc tiles bake` on the file."""
+    import shutil
+
+    import numpy as np
+    import pmc.dem
+
+    lat = np.arange(89.5, -90, -1.0)
+    lon = np.arange(-179.5, 180, 1.0)
+    heights = (2000 * np.sin(np.radians(lon))[None, :] * np.cos(np.radians(lat))[:, None]).astype(np.float32)
+    store = tmp_path / "store"
+    store.mkdir()
+    pmc.dem.import_array(heights, store / "relief.pmcdem", extent=(-180, -90, 180, 90))
+    local = tmp_path / "local.pmcdem"
+    shutil.copy(store / "relief.pmcdem", local)
+    planet = pmc.Planet.from_dem(local)
+    ref = tmp_path / "ref"
+    subprocess.run([str(pmc_bin), "tiles", "bake", "--quiet", "--dem", str(local), "--region", "10,20,20000", "--max-level", "8", "-o", str(ref)], check=True)
+    local.unlink()
+    out = tmp_path / "tiles"
+    pmc.bake.tiles(planet, str(out), region=(10.0, 20.0, 20000.0), max_level=8, client=dask_client, dem_url=f"file://{store}/relief.pmcdem")
+    assert tree(out) == tree(ref)
+
+
 def test_pmc_bake_console_script_on_a_scheduler(dask_client, pmc_bin, tmp_path):
     out = tmp_path / "cli"
     # The console script the package installs beside the interpreter.
@@ -140,3 +170,25 @@ def test_pmc_bake_console_script_on_a_scheduler(dask_client, pmc_bin, tmp_path):
     assert tree(out) == tree(ref)
     bad = subprocess.run(script + ["--scheduler", dask_client.scheduler.address, "--region", "1,2", "-o", str(tmp_path / "x")], capture_output=True, text=True)
     assert bad.returncode == 1 and "--region" in bad.stderr
+
+
+def test_a_bakes_units_are_checked():
+    from pmc import _pmc
+
+    tiles = _pmc.TileBake(pmc.Planet("moon", 3)._native, max_level=3)
+    roots = tiles.roots()
+    assert len(roots) == 6 and all(r[1] == 0 for r in roots)
+    files, children = tiles.subtree(roots[0])
+    assert files[-1][0] == tiles.subtree_path(roots[0]) and files[-1][1] is None
+    assert all(path.startswith("content/") and level is not None for path, level, _ in files[:-1])
+    assert children == tiles.children(roots[0])
+    with pytest.raises(pmc.PmcError, match="cube face"):
+        tiles.subtree((9, 0, 0, 0, 0))
+    with pytest.raises(pmc.PmcError, match="no subtree root"):
+        tiles.subtree((0, 1, 0, 0, 0))
+    with pytest.raises(pmc.PmcError, match="not a tile of this bake"):
+        tiles.children((0, 3, 1000, 0, 0))
+    with pytest.raises(pmc.PmcError, match="frame"):
+        _pmc.TileBake(pmc.Planet("moon", 3)._native, frame="mercator")
+    with pytest.raises(pmc.PmcError, match="max-level"):
+        _pmc.TileBake(pmc.Planet("moon", 3)._native, max_level=40)
