@@ -1,8 +1,9 @@
 """Planets bigger than one machine: 3D Tiles baked on a Dask cluster.
 
 :func:`tiles` writes the same OGC 3D Tiles 1.1 tileset as ``pmc tiles bake``, byte for byte,
-with the work split into one task per subtree (73 tiles, three levels) and run on a
-``dask.distributed`` cluster: a ``LocalCluster`` on a laptop, or a cluster's scheduler. Workers
+with the work split into tasks by subtree (three tile levels, up to 73 tiles; a task also bakes
+the small subtrees at the bottom of the tree below its own) and run on a ``dask.distributed``
+cluster: a ``LocalCluster`` on a laptop, or a cluster's scheduler. Workers
 receive only the planet's spec (a preset and seed; an elevation file's path or URL and digest; a
 world file) and build the planet themselves, never meshes from the client. Every file is written
 whole or not at all, the bake resumes where a killed one stopped, and a worker lost mid-bake has
@@ -32,6 +33,9 @@ Root = Tuple[int, int, int, int, int]
 
 #: How many times a subtree's task is submitted again after its worker was lost or restarted.
 RETRIES = 5
+
+#: Tile levels in a subtree file (`pmc_tiles::SUBTREE_LEVELS`).
+SUBTREE_LEVELS = 3
 
 # Per process (a worker's, or the client's): the tile sets built, by spec and options.
 _TILE_SETS: Dict[str, Any] = {}
@@ -98,32 +102,68 @@ def _write(fs: Any, root: str, rel: str, data: bytes) -> None:
     ``.partial/`` and a rename; object stores write an object at once."""
     final = f"{root}/{rel}"
     if _is_local(fs):
-        os.makedirs(os.path.dirname(final), exist_ok=True)
         tmp = os.path.join(root, ".partial", f"{uuid.uuid4().hex}.tmp")
         with open(tmp, "wb") as f:
             f.write(data)
-        os.replace(tmp, final)
+        try:
+            os.replace(tmp, final)
+        except FileNotFoundError:
+            # Its folder is new (made only now: most files go to a folder made before).
+            os.makedirs(os.path.dirname(final), exist_ok=True)
+            os.replace(tmp, final)
     else:
         fs.pipe_file(final, data)
 
 
 def _bake_subtree(spec: Dict[str, Any], options: Dict[str, Any], root: Root, out: str) -> Dict[str, Any]:
-    """One task: bakes the subtree at ``root`` into ``out`` (skipped when its subtree file is
-    there: a resumed bake) and says what it wrote and which subtrees lie below."""
+    """One task: bakes the subtree at ``root`` into ``out``, and with it the subtrees below it
+    that have none below them (the bottom of the tree: many small subtrees, baked here side by
+    side on every core rather than as tasks of their own). Subtrees whose file is there are
+    skipped (a resumed bake). Says what it wrote and which subtrees below are left to bake."""
     tiles = _tile_set(spec, options)
     fs, path = _fs(out)
-    if fs.exists(f"{path}/{tiles.subtree_path(root)}"):
-        return {"root": root, "children": tiles.children(root), "resumed": True, "levels": [], "subtree_bytes": 0}
-    files, children = tiles.subtree(root)
-    levels: List[Tuple[int, int]] = []
-    subtree_bytes = 0
-    for rel, level, data in files:
-        _write(fs, path, rel, data)
-        if level is None:
-            subtree_bytes = len(data)
+    result: Dict[str, Any] = {"root": root, "children": [], "subtrees": 0, "resumed": 0, "levels": [], "subtree_bytes": 0}
+
+    def written(files: List[Tuple[str, Optional[int], bytes]]) -> None:
+        for rel, level, data in files:
+            _write(fs, path, rel, data)
+            if level is None:
+                result["subtree_bytes"] += len(data)
+            else:
+                result["levels"].append((level, len(data)))
+        result["subtrees"] += 1
+
+    def baked(r: Root) -> bool:
+        return fs.exists(f"{path}/{tiles.subtree_path(r)}")
+
+    leaves: List[Root] = []
+
+    def below(children: List[Root]) -> None:
+        for c in children:
+            if c[1] + SUBTREE_LEVELS >= tiles.levels:
+                leaves.append(c)
+            else:
+                result["children"].append(c)
+
+    if baked(root):
+        result["resumed"] += 1
+        below(tiles.children(root))
+    else:
+        files, children = tiles.subtree(root)
+        written(files)
+        below(children)
+    todo = []
+    for leaf in leaves:
+        if baked(leaf):
+            result["resumed"] += 1
         else:
-            levels.append((level, len(data)))
-    return {"root": root, "children": children, "resumed": False, "levels": levels, "subtree_bytes": subtree_bytes}
+            todo.append(leaf)
+    # A few at a time, as `pmc tiles bake` does: every core busy, memory bounded.
+    batch = max(2, 2 * _pmc.threads())
+    for i in range(0, len(todo), batch):
+        for files, _ in tiles.subtrees(todo[i : i + batch]):
+            written(files)
+    return result
 
 
 def _prepare(fs: Any, path: str, out: str, manifest: bytes) -> None:
@@ -212,8 +252,9 @@ def tiles(
       its path on the client is not theirs.
     - ``progress``: called after each subtree with the running figures.
 
-    Returns the bake's figures: tiles, bytes, subtrees written and resumed, tiles per level,
-    seconds, tiles per second. A task that fails (a worker without the elevation file, an
+    A task bakes one subtree and, with it, the subtrees at the bottom of the tree below it (which
+    have none below them). Returns the bake's figures: tiles, bytes, subtrees written and
+    resumed, tasks, tiles per level, seconds, tiles per second. A task that fails (a worker without the elevation file, an
     unwritable output) fails the bake with the worker's message as :class:`pmc.PmcError`;
     files are only ever written whole.
     """
@@ -237,7 +278,7 @@ def tiles(
     if own:
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
         client = Client(cluster)
-    stats: Dict[str, Any] = {"tiles": 0, "bytes": 0, "subtrees": 0, "resumed": 0, "levels": {}, "subtree_bytes": 0}
+    stats: Dict[str, Any] = {"tiles": 0, "bytes": 0, "subtrees": 0, "resumed": 0, "tasks": 0, "levels": {}, "subtree_bytes": 0}
     try:
         tries: Dict[Root, int] = {}
 
@@ -260,19 +301,18 @@ def tiles(
                     f.cancel()
                 raise PmcError(f"the bake failed on a worker: {e}") from e
             future.release()
+            stats["tasks"] += 1
             for c in result["children"]:
                 done.add(submit(tuple(c)))
-            if result["resumed"]:
-                stats["resumed"] += 1
-            else:
-                stats["subtrees"] += 1
-                stats["subtree_bytes"] += result["subtree_bytes"]
-                for level, n in result["levels"]:
-                    lv = stats["levels"].setdefault(level, [0, 0])
-                    lv[0] += 1
-                    lv[1] += n
-                    stats["tiles"] += 1
-                    stats["bytes"] += n
+            stats["resumed"] += result["resumed"]
+            stats["subtrees"] += result["subtrees"]
+            stats["subtree_bytes"] += result["subtree_bytes"]
+            for level, n in result["levels"]:
+                lv = stats["levels"].setdefault(level, [0, 0])
+                lv[0] += 1
+                lv[1] += n
+                stats["tiles"] += 1
+                stats["bytes"] += n
             if progress is not None:
                 progress(dict(stats))
         _write(fs, path, "tileset.json", tileset.tileset())

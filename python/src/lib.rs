@@ -779,6 +779,42 @@ impl PyTileBake {
         Ok(bake::subtree_path(&self.coord(root)?))
     }
 
+    /// The tile levels of the bake (levels 0 to `levels - 1` have tiles): a subtree rooted at
+    /// `levels - 3` or deeper has no child subtrees.
+    #[getter]
+    fn levels(&self) -> u8 {
+        self.tiles.available_levels()
+    }
+
+    /// Bakes several subtrees in memory side by side (on every core), each as
+    /// [`PyTileBake::subtree`] does: what a task of a distributed bake does with the small
+    /// subtrees at the bottom of the tree, which would cost more as tasks of their own than
+    /// they take to bake.
+    fn subtrees<'py>(&self, py: Python<'py>, roots: Vec<Root>) -> PyResult<Vec<(Vec<BakeFile<'py>>, Vec<Root>)>> {
+        let roots = roots.into_iter().map(|r| self.coord(r)).collect::<PyResult<Vec<_>>>()?;
+        let tiles = self.tiles.clone();
+        let done = py
+            .detach(move || {
+                roots
+                    .par_iter()
+                    .map(|r| bake::subtree_files(&tiles, *r))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(err)?;
+        Ok(done
+            .into_iter()
+            .map(|SubtreeFiles { files, children }| {
+                (
+                    files
+                        .into_iter()
+                        .map(|f| (f.path, f.level, PyBytes::new(py, &f.bytes)))
+                        .collect(),
+                    children.iter().map(tile_coord).collect(),
+                )
+            })
+            .collect())
+    }
+
     /// The roots of the child subtrees of `root` that hold tiles (what a resumed bake walks
     /// into without baking `root` again).
     fn children(&self, root: Root) -> PyResult<Vec<Root>> {
@@ -822,7 +858,9 @@ impl PyTileBake {
                 pmc_tiles::SUBTREE_LEVELS
             )));
         }
-        if !self.tiles.available(&t) {
+        // (`candidate`, not `available`: the latter samples the tile's chunk, which the callers
+        // do anyway or do not need)
+        if !self.tiles.candidate(&t) {
             return Err(err(format!(
                 "tile {}/{} is not a tile of this bake",
                 face.name(),
@@ -851,6 +889,13 @@ fn chunk_key(planet: &PyPlanet, face: &Bound<'_, PyAny>, level: u64, i: u64, j: 
     ))
 }
 
+/// The threads the engine works on in this process (rayon's pool: one per core, or
+/// `RAYON_NUM_THREADS`).
+#[pyfunction]
+fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
 /// The native module.
 #[pymodule]
 fn _pmc(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -863,5 +908,6 @@ fn _pmc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTileBake>()?;
     m.add_function(wrap_pyfunction!(import_dem_array, m)?)?;
     m.add_function(wrap_pyfunction!(chunk_key, m)?)?;
+    m.add_function(wrap_pyfunction!(threads, m)?)?;
     Ok(())
 }

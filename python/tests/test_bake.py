@@ -60,17 +60,28 @@ def test_an_fsspec_url_is_an_output_like_a_folder(reference, dask_client, tmp_pa
 
 
 def test_a_worker_killed_mid_bake_changes_no_byte(reference, dask_client, tmp_path):
+    """SIGKILL of a worker process while it bakes a subtree: its task is baked again on the
+    other worker (then the restarted one), and the folder is the same bytes."""
+    import time
+
     killed = []
 
-    def kill_one(stats):
-        if not killed and stats["subtrees"] >= 2:
-            pids = dask_client.run(os.getpid)
-            victim = sorted(pids.values())[0]
-            os.kill(victim, signal.SIGKILL)
-            killed.append(victim)
+    def kill_a_busy_worker(stats):
+        if killed:
+            return
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            busy = [w for w, tasks in dask_client.processing().items() if any("pmc-subtree" in str(t) for t in tasks)]
+            if busy:
+                pid = dask_client.run(os.getpid, workers=busy[:1])[busy[0]]
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+                return
+            time.sleep(0.005)
 
-    bake(tmp_path / "tiles", dask_client, progress=kill_one)
-    assert killed, "no worker was killed: the bake ended before its third subtree"
+    stats = bake(tmp_path / "tiles", dask_client, progress=kill_a_busy_worker)
+    assert killed, "no worker was busy with a subtree after the first one"
+    assert stats["tasks"] > 2
     assert tree(tmp_path / "tiles") == reference
     dask_client.wait_for_workers(2, timeout=60)
 
