@@ -17,29 +17,36 @@ import pyvista as pv
 import pmc
 
 planet = pmc.Planet("earthlike", seed=7)
-# The highest ground among a few places: a mountain, with its slopes, snow and cave mouths.
-lat, lon = np.meshgrid(np.linspace(-40, 40, 41), np.linspace(-180, 175, 72), indexing="ij")
-heights = planet.surface_height(lat, lon)
-i = np.unravel_index(np.argmax(heights), heights.shape)
-place = float(lat[i]), float(lon[i])
-print(f"the highest sampled ground: {heights[i]:.0f} m at {place}")
+# The place of the viewer's close-up (README): a ridge with snowfields and cave mouths above a
+# bay with a beach.
+place = (3.0, 9.0)
+ground = planet.surface_height(*place)
+print(f"the ground at {place}: {ground:.0f} m above the sea")
 
 # %%
-region = planet.region(place[0], place[1], 500.0, level=0)
+region = planet.region(place[0], place[1], 450.0, level=0)
 mesh = region.to_pyvista()
 print(region, f"from {region.chunks} chunks")
+# The mesh is the ground, the sea floor included: tint the floor by the depth of water above it
+# (the vertices' `water_depth`), as the viewer's translucent sea does.
+depth = mesh.point_data["water_depth"][:, None]
+sea = np.array([28.0, 92.0, 128.0])
+clear = np.exp(-depth / 6.0)
+mesh.point_data["colors"] = (mesh.point_data["colors"] * clear + sea * (1 - clear)).astype(np.uint8)
 
 # %%
 pv.OFF_SCREEN = True
 plotter = pv.Plotter(off_screen=True, window_size=(1280, 720))
 plotter.set_background("#0b1020", top="#3a5f8f")
 plotter.add_mesh(mesh, scalars="colors", rgb=True, smooth_shading=True, specular=0.1)
-centre = region.positions.mean(axis=0)
-up = centre / np.linalg.norm(centre)
+# Looking at the place from the south-east and above it.
+lat0, lon0 = np.radians(place[0]), np.radians(place[1])
+up = np.array([np.cos(lat0) * np.sin(lon0), np.sin(lat0), np.cos(lat0) * np.cos(lon0)])
+centre = up * (planet.info()["datum_radius"] + ground)
 east = np.cross([0.0, 1.0, 0.0], up)
 east /= np.linalg.norm(east)
 north = np.cross(up, east)
-plotter.camera_position = [tuple(centre + 420 * up - 700 * north + 250 * east), tuple(centre), tuple(up)]
+plotter.camera_position = [tuple(centre + 330 * up - 480 * north + 260 * east), tuple(centre - 40 * up + 60 * north), tuple(up)]
 out = sys.argv[1] if len(sys.argv) > 1 else "python-pyvista.png"
 plotter.screenshot(out)
 print("wrote", out)
