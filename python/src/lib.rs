@@ -75,26 +75,6 @@ struct PyPlanet {
     world: Option<(PathBuf, usize)>,
 }
 
-/// The layout options as the crates take them.
-#[allow(clippy::too_many_arguments)]
-fn layout_choice(
-    radius: Option<f64>,
-    n_c: Option<u32>,
-    n_t: Option<u32>,
-    d_b: Option<f64>,
-    l_d: Option<f64>,
-    d_c: Option<u32>,
-) -> LayoutChoice {
-    LayoutChoice {
-        radius,
-        n_c,
-        n_t,
-        d_b,
-        l_d,
-        d_c,
-    }
-}
-
 fn build_planet(terrain: &TerrainSpec, choice: &LayoutChoice) -> PyResult<Planet> {
     let layout = choice.resolve(terrain).map_err(err)?;
     Planet::from_terrain(terrain, layout).map_err(err)
@@ -146,7 +126,14 @@ impl PyPlanet {
         dem: Option<PathBuf>,
         interpolation: &str,
     ) -> PyResult<PyPlanet> {
-        let choice = layout_choice(radius, n_c, n_t, d_b, l_d, d_c);
+        let choice = LayoutChoice {
+            radius,
+            n_c,
+            n_t,
+            d_b,
+            l_d,
+            d_c,
+        };
         let terrain = match dem {
             Some(path) => {
                 let interp = Interpolation::from_str(interpolation).map_err(err)?;

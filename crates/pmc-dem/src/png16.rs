@@ -153,22 +153,7 @@ impl EquirectDem {
                 ),
             });
         }
-        if (width as u64).saturating_mul(height as u64) > MAX_CELLS {
-            return Err(DemError::TooLarge {
-                file: name.to_owned(),
-                width: width as u64,
-                height: height as u64,
-                limit: MAX_CELLS,
-            });
-        }
-        let lon_label = "longitude (array columns)";
-        let lat_label = "latitude (array rows)";
-        let lon = axis::longitudes(
-            positions(name, lon_label, extent.west, extent.east, width, extent.cell_centres)?,
-            width,
-        )
-        .map_err(|p| read::axis_error(name, lon_label, p))?;
-        let lat = positions(name, lat_label, extent.south, extent.north, height, extent.cell_centres)?;
+        let (lon, lat) = axes(name, width, height, extent, "array")?;
         let mut out = Vec::with_capacity(lon.width * height);
         for r in 0..height {
             let src = if north_first { height - 1 - r } else { r };
@@ -266,22 +251,7 @@ fn decode(file: &str, source: String, bytes: &[u8], extent: &PngExtent) -> Resul
             detail: format!("the image is {w} x {h} pixels"),
         });
     }
-    if (w as u64).saturating_mul(h as u64) > MAX_CELLS {
-        return Err(DemError::TooLarge {
-            file: file.to_owned(),
-            width: w as u64,
-            height: h as u64,
-            limit: MAX_CELLS,
-        });
-    }
-    let lon_label = "longitude (PNG columns)";
-    let lat_label = "latitude (PNG rows)";
-    let lon = axis::longitudes(
-        positions(file, lon_label, extent.west, extent.east, w, extent.cell_centres)?,
-        w,
-    )
-    .map_err(|p| read::axis_error(file, lon_label, p))?;
-    let lat = positions(file, lat_label, extent.south, extent.north, h, extent.cell_centres)?;
+    let (lon, lat) = axes(file, w, h, extent, "PNG")?;
 
     let mut raw = vec![0u8; w * h * 2];
     reader.next_frame(&mut raw).map_err(|e| png_error(file, len, e))?;
@@ -317,6 +287,34 @@ fn decode(file: &str, source: String, bytes: &[u8], extent: &PngExtent) -> Resul
         wraps: lon.wraps,
         heights,
     })
+}
+
+/// The axes of a grid of `w` columns and `h` rows placed by `extent` (`what` names its columns
+/// and rows in errors: "PNG", "array"), refused when it has more than [`MAX_CELLS`] cells.
+fn axes(
+    file: &str,
+    w: usize,
+    h: usize,
+    extent: &PngExtent,
+    what: &str,
+) -> Result<(axis::Longitudes, Regular), DemError> {
+    if (w as u64).saturating_mul(h as u64) > MAX_CELLS {
+        return Err(DemError::TooLarge {
+            file: file.to_owned(),
+            width: w as u64,
+            height: h as u64,
+            limit: MAX_CELLS,
+        });
+    }
+    let lon_label = format!("longitude ({what} columns)");
+    let lat_label = format!("latitude ({what} rows)");
+    let lon = axis::longitudes(
+        positions(file, &lon_label, extent.west, extent.east, w, extent.cell_centres)?,
+        w,
+    )
+    .map_err(|p| read::axis_error(file, &lon_label, p))?;
+    let lat = positions(file, &lat_label, extent.south, extent.north, h, extent.cell_centres)?;
+    Ok((lon, lat))
 }
 
 /// The axis of `n` samples between bounds `lo` and `hi`: pixel centres or nodes.
