@@ -343,6 +343,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         "cluster: a local one, or the scheduler given. Resumable: run it again after an interrupt.",
     )
     p.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler, e.g. tcp://HOST:8786 (default: a local cluster)")
+    p.add_argument("--timeout", type=float, default=30, metavar="SECONDS", help="how long to wait for --scheduler (default 30)")
     p.add_argument("--workers", type=int, default=2, metavar="N", help="worker processes of the local cluster (default 2)")
     p.add_argument("--preset", default="earthlike", help="sphere, earthlike, moon, mars or earth (default earthlike)")
     p.add_argument("--seed", type=int, default=7, help="terrain seed (default 7)")
@@ -362,7 +363,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     try:
         layout = {"n_c": a.n_c, "n_t": a.n_t, "d_b": a.d_b, "l_d": a.l_d, "d_c": a.d_c}
         if a.world:
-            planet = Planet.open_world(a.world).planet
+            with Planet.open_world(a.world) as w:
+                planet = w.planet
         elif a.dem:
             planet = Planet.from_dem(a.dem, a.seed, **layout)
         else:
@@ -375,15 +377,22 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 region = []
             if len(region) != 3:
                 raise PmcError(f"--region is LAT,LON,RADIUS_M, got {a.region!r}")
-        client = None
-        if a.scheduler:
-            from dask.distributed import Client
+        from dask.distributed import Client, LocalCluster
 
-            client = Client(a.scheduler)
-        elif not a.quiet:
-            print(f"pmc-bake: a local cluster of {a.workers} workers", file=sys.stderr)
-        if client is not None and not a.quiet:
-            print(f"pmc-bake: scheduler {a.scheduler}, dashboard {client.dashboard_link}", file=sys.stderr)
+        cluster = None
+        if a.scheduler:
+            try:
+                client = Client(a.scheduler, timeout=a.timeout)
+            except (OSError, TimeoutError) as e:
+                raise PmcError(f"no Dask scheduler answers at {a.scheduler}: {e}") from e
+            where = f"scheduler {a.scheduler}"
+        else:
+            cluster = LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+            client = Client(cluster)
+            where = f"a local cluster of {a.workers} workers"
+        if not a.quiet:
+            # The dashboard's progress and task stream show the subtrees being baked.
+            print(f"pmc-bake: {where}, dashboard {client.dashboard_link}", file=sys.stderr)
 
         def say(s: Dict[str, Any]) -> None:
             if not a.quiet:
@@ -393,20 +402,22 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                     file=sys.stderr,
                 )
 
-        stats = tiles(
-            planet,
-            a.output,
-            max_level=a.max_level,
-            min_level=a.min_level,
-            region=region,
-            frame=a.frame,
-            client=client,
-            workers=a.workers,
-            dem_url=a.dem_url,
-            progress=say,
-        )
-        if client is not None:
+        try:
+            stats = tiles(
+                planet,
+                a.output,
+                max_level=a.max_level,
+                min_level=a.min_level,
+                region=region,
+                frame=a.frame,
+                client=client,
+                dem_url=a.dem_url,
+                progress=say,
+            )
+        finally:
             client.close()
+            if cluster is not None:
+                cluster.close()
     except PmcError as e:
         print(f"\npmc-bake: error: {e}", file=sys.stderr)
         return 1

@@ -181,6 +181,8 @@ def test_pmc_bake_console_script_on_a_scheduler(dask_client, pmc_bin, tmp_path):
     assert tree(out) == tree(ref)
     bad = subprocess.run(script + ["--scheduler", dask_client.scheduler.address, "--region", "1,2", "-o", str(tmp_path / "x")], capture_output=True, text=True)
     assert bad.returncode == 1 and "--region" in bad.stderr
+    nobody = subprocess.run(script + ["--scheduler", "tcp://127.0.0.1:9", "--timeout", "2", "-o", str(tmp_path / "y")], capture_output=True, text=True, timeout=120)
+    assert nobody.returncode == 1 and "no Dask scheduler answers" in nobody.stderr, nobody.stderr
 
 
 def test_a_bakes_units_are_checked():
