@@ -128,11 +128,11 @@ rm -rf "$TARGET_DIR/wheels"
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$TARGET_DIR"/wheels/pmc-*.whl
 # From another directory, so that `import pmc` is the installed wheel, not the source folder.
 (cd "$TARGET_DIR" && PMC_BIN="$PMC" TMPDIR="$SCRATCH" "$VENV/bin/python" -m pytest "$OLDPWD/python/tests" -q -p no:cacheprovider 2>&1) | tee "$TARGET_DIR/pytest.log"
+PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' "$TARGET_DIR/pytest.log" | tail -1)
 
 if [ "$QUICK" = 1 ]; then
   step "quick mode: exports, external validators and the end-to-end tests not run"
   VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
-  PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' "$TARGET_DIR/pytest.log" | tail -1)
   awk -v ext="$((${VITEST:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/cargo-test.log
   exit 0
 fi
@@ -172,5 +172,4 @@ step "all checks passed"
 EXTERNAL_CHECKS=5
 VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
-PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' "$TARGET_DIR/pytest.log" | tail -1)
 awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log

@@ -159,7 +159,7 @@ def _bake_subtree(spec: Dict[str, Any], options: Dict[str, Any], root: Root, out
         else:
             todo.append(leaf)
     # A few at a time, as `pmc tiles bake` does: every core busy, memory bounded.
-    batch = max(2, 2 * _pmc.threads())
+    batch = _pmc.bake_batch()
     for i in range(0, len(todo), batch):
         for files, _ in tiles.subtrees(todo[i : i + batch]):
             written(files)
@@ -281,10 +281,12 @@ def tiles(
     stats: Dict[str, Any] = {"tiles": 0, "bytes": 0, "subtrees": 0, "resumed": 0, "tasks": 0, "levels": {}, "subtree_bytes": 0}
     try:
         tries: Dict[Root, int] = {}
+        root_of: Dict[str, Root] = {}
 
         def submit(root: Root) -> Any:
             tries[root] = tries.get(root, 0) + 1
             key = f"pmc-subtree-{root[0]}-{root[1]}-{root[2]}-{root[3]}-{root[4]}-{uuid.uuid4().hex[:8]}"
+            root_of[key] = root
             return client.submit(_bake_subtree, spec, options, root, out, key=key, pure=False)
 
         done = as_completed([submit(tuple(r)) for r in tileset.roots()])
@@ -293,8 +295,8 @@ def tiles(
                 result = future.result()
             except Exception as e:  # the task's error, or the worker lost
                 cancelled = type(e).__name__ in ("CancelledError", "KilledWorker", "FutureCancelledError")
-                root = _root_of_key(future.key)
-                if cancelled and root is not None and tries.get(root, 0) <= RETRIES:
+                root = root_of[future.key]
+                if cancelled and tries[root] <= RETRIES:
                     done.add(submit(root))
                     continue
                 for f in list(done.futures):
@@ -326,13 +328,6 @@ def tiles(
     stats["tiles_per_second"] = stats["tiles"] / max(stats["seconds"], 1e-9)
     stats["levels"] = {k: {"tiles": v[0], "bytes": v[1]} for k, v in sorted(stats["levels"].items())}
     return stats
-
-
-def _root_of_key(key: str) -> Optional[Root]:
-    parts = key.split("-")
-    if len(parts) != 8 or parts[0] != "pmc" or parts[1] != "subtree":
-        return None
-    return tuple(int(p) for p in parts[2:7])  # type: ignore[return-value]
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:

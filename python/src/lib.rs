@@ -13,7 +13,7 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pmc_edit::BrushOp;
 use pmc_geometry::glam::DVec3;
-use pmc_geometry::{ChunkKey, Face, LatLon, SideMask};
+use pmc_geometry::{Face, LatLon, SideMask};
 use pmc_mesh::ChunkMesh;
 use pmc_planet::{Interpolation, LayoutChoice, Planet, PresetKind, TerrainSpec};
 use pmc_tiles::bake::{self, SubtreeFiles};
@@ -84,12 +84,12 @@ fn build_planet(terrain: &TerrainSpec, choice: &LayoutChoice) -> PyResult<Planet
 fn mesh_dict(py: Python<'_>, m: ChunkMesh) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("origin", column(py, m.origin.to_array().to_vec()))?;
-    d.set_item("positions", rows(py, m.positions.into_flattened(), 3))?;
     let low = if m.positions_low.is_empty() {
-        vec![0f32; d.get_item("positions")?.map_or(0, |p| p.len().unwrap_or(0)) * 3]
+        vec![0f32; m.positions.len() * 3]
     } else {
         m.positions_low.into_flattened()
     };
+    d.set_item("positions", rows(py, m.positions.into_flattened(), 3))?;
     d.set_item("positions_low", rows(py, low, 3))?;
     d.set_item("normals", rows(py, m.normals.into_flattened(), 3))?;
     d.set_item("colors", rows(py, m.colors.into_flattened(), 4))?;
@@ -573,12 +573,11 @@ impl PyWorld {
     ) -> PyResult<u64> {
         let material = material.map(|m| m.str().map(|s| s.to_string())).transpose()?;
         let brush = brush.to_string();
+        // `planet` holds the world's active edits (`change` keeps it so): a brush put on the
+        // ground lands on the edited ground.
         self.change(py, move |w, planet| {
-            let current = planet
-                .clone()
-                .with_edits(w.active_edits().map_err(|e| e.to_string())?.into());
-            let kind = current.brush_kind(&brush, material.as_deref())?;
-            let centre = current.place(lat, lon, alt)?;
+            let kind = planet.brush_kind(&brush, material.as_deref())?;
+            let centre = planet.place(lat, lon, alt)?;
             let op = BrushOp::new(kind, centre, radius, strength).map_err(|e| e.to_string())?;
             w.append(&op).map(|id| id.0).map_err(|e| e.to_string())
         })
@@ -788,18 +787,7 @@ impl PyTileBake {
                     .collect::<Result<Vec<_>, _>>()
             })
             .map_err(err)?;
-        Ok(done
-            .into_iter()
-            .map(|SubtreeFiles { files, children }| {
-                (
-                    files
-                        .into_iter()
-                        .map(|f| (f.path, f.level, PyBytes::new(py, &f.bytes)))
-                        .collect(),
-                    children.iter().map(tile_coord).collect(),
-                )
-            })
-            .collect())
+        Ok(done.into_iter().map(|d| subtree_to_py(py, d)).collect())
     }
 
     /// The roots of the child subtrees of `root` that hold tiles (what a resumed bake walks
@@ -818,15 +806,20 @@ impl PyTileBake {
     fn subtree<'py>(&self, py: Python<'py>, root: Root) -> PyResult<(Vec<BakeFile<'py>>, Vec<Root>)> {
         let root = self.coord(root)?;
         let tiles = self.tiles.clone();
-        let SubtreeFiles { files, children } = py.detach(move || bake::subtree_files(&tiles, root)).map_err(err)?;
-        Ok((
-            files
-                .into_iter()
-                .map(|f| (f.path, f.level, PyBytes::new(py, &f.bytes)))
-                .collect(),
-            children.iter().map(tile_coord).collect(),
-        ))
+        let done = py.detach(move || bake::subtree_files(&tiles, root)).map_err(err)?;
+        Ok(subtree_to_py(py, done))
     }
+}
+
+/// A subtree's bake as Python sees it: its files as `(path, level, bytes)`, its children's roots.
+fn subtree_to_py(py: Python<'_>, SubtreeFiles { files, children }: SubtreeFiles) -> (Vec<BakeFile<'_>>, Vec<Root>) {
+    (
+        files
+            .into_iter()
+            .map(|f| (f.path, f.level, PyBytes::new(py, &f.bytes)))
+            .collect(),
+        children.iter().map(tile_coord).collect(),
+    )
 }
 
 impl PyTileBake {
@@ -858,29 +851,10 @@ impl PyTileBake {
     }
 }
 
-/// The chunk key text `face/level/i/j/k` of a chunk, checked against `planet`.
+/// How many subtrees a bake meshes side by side in this process ([`bake::batch`]).
 #[pyfunction]
-fn chunk_key(planet: &PyPlanet, face: &Bound<'_, PyAny>, level: u64, i: u64, j: u64, k: u64) -> PyResult<String> {
-    let key: ChunkKey = planet
-        .planet
-        .layout()
-        .chunk_key(face_of(face)?, level, i, j, k)
-        .map_err(err)?;
-    Ok(format!(
-        "{}/{}/{}/{}/{}",
-        key.face.name(),
-        key.level,
-        key.i,
-        key.j,
-        key.k
-    ))
-}
-
-/// The threads the engine works on in this process (rayon's pool: one per core, or
-/// `RAYON_NUM_THREADS`).
-#[pyfunction]
-fn threads() -> usize {
-    rayon::current_num_threads()
+fn bake_batch() -> usize {
+    bake::batch()
 }
 
 /// The native module.
@@ -894,7 +868,6 @@ fn _pmc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyWorld>()?;
     m.add_class::<PyTileBake>()?;
     m.add_function(wrap_pyfunction!(import_dem_array, m)?)?;
-    m.add_function(wrap_pyfunction!(chunk_key, m)?)?;
-    m.add_function(wrap_pyfunction!(threads, m)?)?;
+    m.add_function(wrap_pyfunction!(bake_batch, m)?)?;
     Ok(())
 }

@@ -174,11 +174,6 @@ impl PlanetArgs {
     /// for `--radius`, or the terrain's own layout (the preset's, or the one for an elevation
     /// model's body radius) with each typed layout option replacing its parameter.
     pub fn layout_for(&self, terrain: &TerrainSpec) -> Result<Layout, CliError> {
-        if self.radius.is_some() && self.dem.is_some() {
-            return Err(CliError::Dem(
-                "--radius does not apply to --dem: the elevation file gives the body's radius".into(),
-            ));
-        }
         let typed = |i: usize| self.typed[i];
         let choice = LayoutChoice {
             radius: self.radius,
@@ -191,6 +186,9 @@ impl PlanetArgs {
         choice.resolve(terrain).map_err(|e| match e {
             TerrainError::Radius(r) => CliError::from(r),
             TerrainError::Layout(l) => CliError::from(l),
+            TerrainError::RadiusWithDem => {
+                CliError::Dem("--radius does not apply to --dem: the elevation file gives the body's radius".into())
+            }
             e => CliError::Dem(e.to_string()),
         })
     }

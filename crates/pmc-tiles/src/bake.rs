@@ -146,7 +146,7 @@ pub fn bake(
         ..BakeStats::default()
     };
     let mut stack: Vec<TileCoord> = roots(tiles).into_iter().rev().collect();
-    let batch = (2 * rayon::current_num_threads()).max(2);
+    let batch = batch();
     while !stack.is_empty() {
         let take = stack.len().min(batch);
         let work: Vec<TileCoord> = stack.split_off(stack.len() - take);
@@ -174,6 +174,13 @@ pub fn bake(
     folder.write("tileset.json", &tileset_bytes(tiles, extras))?;
     std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
     Ok(stats)
+}
+
+/// How many subtrees a bake meshes side by side, each on every core: enough to keep the cores
+/// busy between subtrees, few enough to bound memory (twice the threads of the rayon pool it
+/// runs in, at least 2).
+pub fn batch() -> usize {
+    (2 * rayon::current_num_threads()).max(2)
 }
 
 /// The text of `generator` in a bake's tileset (`asset.generator`): `pmc` and its version.
