@@ -258,6 +258,17 @@ export async function scenario(t) {
     // the edit someone will make while the page is away, under the camera (its body computed now,
     // on the first server)
     const body = JSON.stringify(await editAt(server.api, -40, 120));
+    // the edit stream stays away until the edit is made: the browser's EventSource retries on its
+    // own every few seconds, and when one of its tries reached the restarted server before the
+    // edit, the page was told of the edit by the stream (naming only the chunks it changed), not
+    // by the hello after it, and the check below failed on the chunks the edit did not touch
+    // (the step 17 flake: "chunks shown as they were before the edit", 73 of 121 fetched again)
+    const events = '**/api/v1/events**';
+    let streamTries = 0;
+    await page.route(events, (route) => {
+      streamTries++;
+      return route.abort('connectionrefused');
+    });
     await server.stopApi();
     // the user zooms in: what the view wants next cannot be fetched
     await page.evaluate(() => window.__pmc.setCamera(-40, 120, 1500, 0, -90));
@@ -274,6 +285,9 @@ export async function scenario(t) {
     const edit = await fetch(`${again.base}api/v1/edits`, { method: 'POST', headers: { 'content-type': 'application/json' }, body });
     check(edit.status === 200, `the edit through the API: ${edit.status} ${await edit.text()}`);
     check(!(await stats(page)).online, 'the page came back online before its Retry button could be tried (the next probe was 8 s away)');
+    check((await stats(page)).edit.revision === rev0, `the page learnt of the edit while its edit stream was held away: ${(await stats(page)).edit.revision}`);
+    await page.unroute(events);
+    log(`  the edit stream's ${streamTries} tries while the server was away refused; the edit made (revision ${rev0 + 1} on the server)`);
     // the chunks the page asks for once it is back: the page cannot know what the edit it missed
     // changed (the stream's hello gives the revision alone), so every chunk it shows must be one
     // fetched from the server that has the edit (reloaded as stale, or fetched for the first time)
