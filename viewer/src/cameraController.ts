@@ -65,7 +65,7 @@ export class CameraController {
   /** The camera of the last frame, planet frame (the floating origin). */
   position: V3 = [0, 0, 0];
   private speedFactor = 1;
-  private readonly raycaster = new THREE.Raycaster();
+  private readonly raycaster = Object.assign(new THREE.Raycaster(), { firstHitOnly: true });
   private readonly ndc = new THREE.Vector2();
 
   /** `terrain()`: the meshes of the loaded terrain, placed around the camera. */

@@ -4,6 +4,7 @@
 // render origin, so nothing jitters at any planet radius.
 
 import * as THREE from 'three';
+import { useBvh } from './raycast';
 import { Atmosphere, type SkySettings } from './atmosphere';
 import { SPACE, type AtmosphereParams } from './atmosphereModel';
 import type { DecodedChunk } from './chunkDecode';
@@ -366,6 +367,7 @@ export class PlanetScene {
     const material = this.terrainMaterial(origin, chunk.face);
     const mesh = new THREE.Mesh(g, material);
     mesh.name = key;
+    useBvh(mesh);
     mesh.userData['seams'] = seams;
     mesh.userData['level'] = chunk.level;
     mesh.frustumCulled = true;

@@ -51,7 +51,7 @@ export async function compareLevels(t, label, cam, fine, minHeight, tolerance, a
   const { hook, ready, shot } = t;
   await hook(() => window.__pmc.debug({ lighting: false }));
   const shots = [];
-  const pickAll = (points) => hook((pts) => pts.map(([x, y]) => window.__pmc.pick(x, y)?.point ?? null), points);
+  const pickAll = async (points) => JSON.parse(await hook((pts) => JSON.stringify(pts.map(([x, y]) => window.__pmc.pick(x, y)?.point ?? null)), points));
   // the places drawn in a vertex's pixel: the surface under its centre and its four antialiasing
   // samples (the pixel's colour is theirs, up to half a pixel from the vertex)
   const samplesOf = (p) => PIXEL_SAMPLES.map(([dx, dy]) => [Math.floor(p.screen[0]) + 0.5 + dx, Math.floor(p.screen[1]) + 0.5 + dy]);
