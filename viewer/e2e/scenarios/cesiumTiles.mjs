@@ -271,6 +271,10 @@ export async function scenario(t) {
   await views(t, 'earth', earth, 39, 0);
   await baked(t, earth);
   await pit(t, earth, 39, 0);
+  // (the page closed before its server: CesiumJS asks for tiles whenever it draws, and a page
+  // left open asked a stopped server for some when the viewport changed; the refusals showed in
+  // the next step's console)
+  await t.page.goto('about:blank');
   await earth.stop();
   // an elevation model (ETOPO5 where installed, as in step 11: the file it imported, or a new one)
   let dem = t.shared.dem;
@@ -283,6 +287,7 @@ export async function scenario(t) {
   }
   const model = await startPmcServe(null, { extra: ['--dem', dem, '--cesium-js', CESIUM_JS] });
   await views(t, 'dem', model, 46.5, 10);
+  await t.page.goto('about:blank');
   await model.stop();
   await t.page.setViewportSize(VIEWPORT);
   // No console error and no failed request in any page of this step (the browser's lists are
