@@ -2,7 +2,8 @@
 // run on every exit, timeouts, child processes, and the steps with their results.
 
 import { spawn } from 'node:child_process';
-import { existsSync, readdirSync } from 'node:fs';
+import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
@@ -161,4 +162,22 @@ export function short(e) {
 
 export function check(cond, message) {
   if (!cond) throw new Error(message);
+}
+
+let sharedDem = null;
+/**
+ * DEM_SOURCE imported once by `pmc dem import` for the steps that only read it (14, 15, 18 and
+ * 19; step 11 checks an import of its own): the `.pmcdem`'s path. A failed import fails each
+ * step that asks for it, with the import's output.
+ */
+export function importedDem() {
+  sharedDem ??= (async () => {
+    const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-dem-'));
+    cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
+    const dem = join(dir, 'earth.pmcdem');
+    const imported = await run(PMC_BIN, ['dem', 'import', DEM_SOURCE, '-o', dem, '--quiet'], 300_000);
+    if (imported.code !== 0) throw new Error(`pmc dem import ${DEM_SOURCE} failed: ${imported.out}`);
+    return dem;
+  })();
+  return sharedDem;
 }

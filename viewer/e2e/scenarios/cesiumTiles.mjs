@@ -10,7 +10,7 @@ import { createReadStream, existsSync, mkdtempSync, rmSync, statSync, writeFileS
 import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { join, normalize, resolve, sep } from 'node:path';
-import { DEM_SOURCE, PMC_BIN, VIEWPORT, artifacts, check, cleanups, log, run, viewerDir } from '../harness.mjs';
+import { PMC_BIN, VIEWPORT, artifacts, check, cleanups, importedDem, log, run, viewerDir } from '../harness.mjs';
 import { decodePng } from '../images.mjs';
 import { startPmcServe } from '../servers.mjs';
 
@@ -276,15 +276,8 @@ export async function scenario(t) {
   // the next step's console)
   await t.page.goto('about:blank');
   await earth.stop();
-  // an elevation model (ETOPO5 where installed, as in step 11: the file it imported, or a new one)
-  let dem = t.shared.dem;
-  if (!dem) {
-    const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-cesium-'));
-    cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
-    dem = join(dir, 'earth.pmcdem');
-    const imported = await run(PMC_BIN, ['dem', 'import', DEM_SOURCE, '-o', dem, '--quiet'], 300_000);
-    check(imported.code === 0, `pmc dem import failed: ${imported.out}`);
-  }
+  // an elevation model (ETOPO5 where installed)
+  const dem = await importedDem();
   const model = await startPmcServe(null, { extra: ['--dem', dem, '--cesium-js', CESIUM_JS] });
   await views(t, 'dem', model, 46.5, 10);
   await t.page.goto('about:blank');

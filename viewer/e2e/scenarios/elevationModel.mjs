@@ -26,8 +26,6 @@ export async function scenario(t) {
   const dem = join(dir, 'earth.pmcdem');
   const imported = await run(PMC_BIN, ['dem', 'import', source, '-o', dem, '--quiet'], 300_000);
   check(imported.code === 0, `pmc dem import failed: ${imported.out}`);
-  // step 19 shows the same file in CesiumJS
-  t.shared.dem = dem;
   // PMC_E2E_IMAGERY: an image to drape over it (the README's pictures: NASA's Visible Earth,
   // /usr/share/xplanet/images/earth.jpg of Debian's xplanet-images)
   const imagery = [];

@@ -9,10 +9,7 @@
 // the level" (the jitter noise's lattice wrapped differently from chunk to chunk: shaders.ts,
 // JITTER_SCALE).
 
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { DEM_SOURCE, PMC_BIN, check, cleanups, log, run } from '../harness.mjs';
+import { check, importedDem, log } from '../harness.mjs';
 import { colourAt, quantile, visiblePlaces } from '../places.mjs';
 import { startBackend } from '../servers.mjs';
 import { viewerModule } from '../viewerModule.mjs';
@@ -131,12 +128,7 @@ export async function scenario(t) {
   await page.goto('about:blank');
   await earth.stop();
   // an elevation model (by default the one-degree ETOPO60 fixture) over the Himalaya
-  const source = DEM_SOURCE;
-  const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-levels-'));
-  cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
-  const dem = join(dir, 'earth.pmcdem');
-  const imported = await run(PMC_BIN, ['dem', 'import', source, '-o', dem, '--quiet'], 300_000);
-  check(imported.code === 0, `pmc dem import failed: ${imported.out}`);
+  const dem = await importedDem();
   const demServer = await startBackend(null, { extra: ['--dem', dem] });
   await page.goto(`${demServer.url}#mode=orbit&lat=29&lon=86`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });

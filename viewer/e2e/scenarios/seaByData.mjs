@@ -8,7 +8,7 @@
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
-import { DEM_SOURCE, PMC_BIN, artifacts, check, cleanups, log, run, viewerDir } from '../harness.mjs';
+import { PMC_BIN, artifacts, check, cleanups, importedDem, log, run, viewerDir } from '../harness.mjs';
 import { readDemGrid } from '../demGrid.mjs';
 import { colourAt, visiblePlaces } from '../places.mjs';
 import { startBackend } from '../servers.mjs';
@@ -115,12 +115,7 @@ async function shorelineFollowsData(t, label, grid, cam, step = 16) {
 
 export async function scenario(t) {
   const { page, hook, consoleProblems, failedResponses } = t;
-  const source = DEM_SOURCE;
-  const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-sea-'));
-  cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
-  const dem = join(dir, 'earth.pmcdem');
-  const imported = await run(PMC_BIN, ['dem', 'import', source, '-o', dem, '--quiet'], 300_000);
-  check(imported.code === 0, `pmc dem import failed: ${imported.out}`);
+  const dem = await importedDem();
   const server = await startBackend(null, { extra: ['--dem', dem] });
   await page.goto(`${server.url}#mode=orbit&lat=26&lon=86`, { waitUntil: 'load', timeout: 60_000 });
   await page.waitForFunction(() => window.__pmc !== undefined, null, { timeout: 30_000 });
@@ -140,6 +135,8 @@ export async function scenario(t) {
   // the Strait of Gibraltar from 30 km, straight down, heights interpolated bilinearly (the sea
   // is where that interpolant is below 0 m: the detail noise fades out toward the datum)
   const coastSource = resolve(viewerDir, '../crates/pmc-dem/tests/fixtures/landmarks/coast.cdf');
+  const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-sea-'));
+  cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
   const coast = join(dir, 'coast.pmcdem');
   const coastImport = await run(PMC_BIN, ['dem', 'import', coastSource, '-o', coast, '--quiet'], 300_000);
   check(coastImport.code === 0, `pmc dem import failed: ${coastImport.out}`);

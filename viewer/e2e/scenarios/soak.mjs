@@ -8,10 +8,7 @@
 // view does not converge, the viewer's streaming state and the server's job table are printed.
 // The page is loaded with `#aa=0` (no antialiasing): the soak times streaming, not the renderer.
 
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { DEM_SOURCE, PMC_BIN, VIEWPORT, check, cleanups, fetchText, log, run } from '../harness.mjs';
+import { DEM_SOURCE, VIEWPORT, check, fetchText, importedDem, log } from '../harness.mjs';
 import { quantile } from '../places.mjs';
 import { startBackend } from '../servers.mjs';
 
@@ -108,11 +105,7 @@ export async function scenario(t) {
   try {
     const earth = await startBackend(null, { extra: ['--preset', 'earth', '--cache-mb', '24'] });
     await soak(t, 'earth', earth, 7);
-    const dir = mkdtempSync(join(tmpdir(), 'pmc-e2e-soak-'));
-    cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
-    const dem = join(dir, 'earth.pmcdem');
-    const imported = await run(PMC_BIN, ['dem', 'import', DEM_SOURCE, '-o', dem, '--quiet'], 300_000);
-    check(imported.code === 0, `pmc dem import failed: ${imported.out}`);
+    const dem = await importedDem();
     const model = await startBackend(null, { extra: ['--dem', dem, '--cache-mb', '24'] });
     await soak(t, /etopo5/i.test(DEM_SOURCE) ? 'ETOPO5' : 'the elevation model', model, 11);
   } finally {
