@@ -96,6 +96,7 @@ cargo clippy --workspace --all-targets --locked --profile test -- -D warnings
 mkdir -p target
 step "viewer: type check and unit tests (vitest)"
 (cd viewer && npx tsc --noEmit && npm test 2>&1) | tee target/vitest.log
+VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 
 step "viewer: build (embedded into pmc by the next step)"
 (cd viewer && npm run --silent build)
@@ -132,7 +133,6 @@ PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) pri
 
 if [ "$QUICK" = 1 ]; then
   step "quick mode: exports, external validators and the end-to-end tests not run"
-  VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
   awk -v ext="$((${VITEST:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/cargo-test.log
   exit 0
 fi
@@ -170,6 +170,5 @@ step "all checks passed"
 # and the two trimesh checks, the tiles' validator run, the tiles' schema and loaders.gl check;
 # any failure there has already stopped the script).
 EXTERNAL_CHECKS=5
-VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
 awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log

@@ -19,7 +19,7 @@
 // hair outside its tile, so along a seam it pokes centimetres out of the neighbour's ground.
 
 import * as THREE from 'three';
-import { bvhRaycast, useBvh } from './raycast';
+import { useBvh } from './raycast';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { FACE_NAMES } from './chunkDecode';
 import type { PlanetScene } from './planetScene';
@@ -107,6 +107,7 @@ export class TilesView {
     tileMeshMatrix(parents, origin, mesh.matrix);
     mesh.matrixWorldNeedsUpdate = true;
     mesh.userData['pmcTerrain'] = true;
+    useBvh(mesh);
   }
 
   /**
@@ -121,10 +122,7 @@ export class TilesView {
     const out: THREE.Object3D[] = [];
     for (const scene of this.tiles.group.children) {
       scene.traverse((o) => {
-        if (!(o as THREE.Mesh).isMesh) return;
-        const mesh = o as THREE.Mesh;
-        if (mesh.raycast !== bvhRaycast) useBvh(mesh);
-        out.push(mesh);
+        if ((o as THREE.Mesh).isMesh) out.push(o);
       });
     }
     return out;

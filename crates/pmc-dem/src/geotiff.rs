@@ -3,7 +3,7 @@
 use crate::axis::{self, Regular, EVEN_TOLERANCE};
 use crate::dem::EquirectDem;
 use crate::error::DemError;
-use crate::read::{self, Layout, MAX_CELLS};
+use crate::read::{self, Layout};
 use crate::source::check_request;
 use crate::source::EquirectSource;
 use std::io::{Cursor, Read, Seek, SeekFrom};
@@ -322,7 +322,7 @@ impl EquirectDem {
     /// for what is read and how it is normalised. [`variable`](Self::variable) is `band 1`.
     ///
     /// Errors: those of [`GeoTiffSource::open`], [`DemError::TooLarge`] for a grid of more than
-    /// [`MAX_CELLS`] cells (refused before the heights are allocated) and
+    /// [`MAX_CELLS`](crate::MAX_CELLS) cells (refused before the heights are allocated) and
     /// [`DemError::NoValidData`] when every sample is missing; each names `path` as displayed.
     pub fn read_geotiff(path: impl AsRef<Path>) -> Result<EquirectDem, DemError> {
         let src = GeoTiffSource::open(path)?;
@@ -336,17 +336,11 @@ impl EquirectDem {
     }
 
     /// Reads every row of `src` (whose errors name `file`) into memory, refusing more than
-    /// [`MAX_CELLS`] cells before allocating and a grid without a valid sample after reading.
+    /// [`MAX_CELLS`](crate::MAX_CELLS) cells before allocating and a grid without a valid
+    /// sample after reading.
     pub(crate) fn from_source(src: &dyn EquirectSource, file: &str, variable: &str) -> Result<EquirectDem, DemError> {
         let (w, h) = (src.width(), src.height());
-        if (w as u64).saturating_mul(h as u64) > MAX_CELLS {
-            return Err(DemError::TooLarge {
-                file: file.to_owned(),
-                width: w as u64,
-                height: h as u64,
-                limit: MAX_CELLS,
-            });
-        }
+        read::check_cells(file, w as u64, h as u64)?;
         let mut heights = vec![0.0f32; w * h];
         src.read_rows(0, h, &mut heights)?;
         if heights.iter().all(|v| v.is_nan()) {

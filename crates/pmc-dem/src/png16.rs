@@ -4,7 +4,7 @@ use crate::axis::{self, Regular, EVEN_TOLERANCE};
 use crate::dem::EquirectDem;
 use crate::error::DemError;
 use crate::geotiff::looks_like;
-use crate::read::{self, MAX_CELLS};
+use crate::read;
 use std::path::Path;
 
 /// Where a PNG's pixels lie and how its values become heights: PNG files carry neither.
@@ -102,8 +102,8 @@ impl EquirectDem {
     /// Errors, each naming `path` as displayed: [`DemError::InvalidExtent`] (checked first),
     /// [`DemError::Io`], [`DemError::NotPng`], [`DemError::PngUnsupported`] (8-bit, colour, or
     /// with alpha: says what was found), [`DemError::PngCorrupt`], [`DemError::Truncated`],
-    /// [`DemError::TooLarge`] (more than [`MAX_CELLS`] pixels, refused before decoding),
-    /// [`DemError::AxisInvalid`] (one column or row of nodes), [`DemError::NoValidData`].
+    /// [`DemError::TooLarge`] (more than [`MAX_CELLS`](crate::MAX_CELLS) pixels, refused before
+    /// decoding), [`DemError::AxisInvalid`] (one column or row of nodes), [`DemError::NoValidData`].
     pub fn read_png16(path: impl AsRef<Path>, extent: &PngExtent) -> Result<EquirectDem, DemError> {
         let path = path.as_ref();
         let file = path.display().to_string();
@@ -290,7 +290,8 @@ fn decode(file: &str, source: String, bytes: &[u8], extent: &PngExtent) -> Resul
 }
 
 /// The axes of a grid of `w` columns and `h` rows placed by `extent` (`what` names its columns
-/// and rows in errors: "PNG", "array"), refused when it has more than [`MAX_CELLS`] cells.
+/// and rows in errors: "PNG", "array"), refused when it has more than
+/// [`MAX_CELLS`](crate::MAX_CELLS) cells.
 fn axes(
     file: &str,
     w: usize,
@@ -298,14 +299,7 @@ fn axes(
     extent: &PngExtent,
     what: &str,
 ) -> Result<(axis::Longitudes, Regular), DemError> {
-    if (w as u64).saturating_mul(h as u64) > MAX_CELLS {
-        return Err(DemError::TooLarge {
-            file: file.to_owned(),
-            width: w as u64,
-            height: h as u64,
-            limit: MAX_CELLS,
-        });
-    }
+    read::check_cells(file, w as u64, h as u64)?;
     let lon_label = format!("longitude ({what} columns)");
     let lat_label = format!("latitude ({what} rows)");
     let lon = axis::longitudes(

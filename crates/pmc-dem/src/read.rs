@@ -13,6 +13,20 @@ use std::path::Path;
 /// [`DemError::TooLarge`] before anything is allocated for them.
 pub const MAX_CELLS: u64 = 1 << 31;
 
+/// Refuses a grid of `width` x `height` cells (of `file`) with more than [`MAX_CELLS`] of them,
+/// before anything is allocated for it.
+pub(crate) fn check_cells(file: &str, width: u64, height: u64) -> Result<(), DemError> {
+    if width.saturating_mul(height) > MAX_CELLS {
+        return Err(DemError::TooLarge {
+            file: file.to_owned(),
+            width,
+            height,
+            limit: MAX_CELLS,
+        });
+    }
+    Ok(())
+}
+
 /// Bytes of a file read first to check its header; more are read if the header is longer.
 const FIRST_HEADER_READ: u64 = 64 * 1024;
 
@@ -211,14 +225,7 @@ pub(crate) fn prepare<R: Read + Seek + 'static>(
     let plan = plan(file, reader.data_set(), variable)?;
     let width_in = plan.lon_dim_size as u64;
     let height_in = plan.lat_dim_size as u64;
-    if width_in.saturating_mul(height_in) > MAX_CELLS {
-        return Err(DemError::TooLarge {
-            file: file.to_owned(),
-            width: width_in,
-            height: height_in,
-            limit: MAX_CELLS,
-        });
-    }
+    check_cells(file, width_in, height_in)?;
     for name in [&plan.lon_var, &plan.lat_var, &plan.grid_var] {
         check_extent(file, info, name, len)?;
     }
