@@ -34,6 +34,33 @@ if ! python3 -c "import trimesh, numpy" 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 fi
 
+# Runs the named functions side by side, each with its output in target/NAME.out, and prints
+# each one's output, in the order given, once it and those before it are done; fails if any
+# failed. The suite's steps that use less than the 2 cores of a small machine share them: the
+# Rust tests alone keep 1.5 busy on average (some of their binaries end with one long test).
+side_by_side() {
+  local names=("$@") pids=() f i failed=()
+  mkdir -p target
+  for f in "$@"; do
+    ( (set -euo pipefail; "$f") > "target/$f.out" 2>&1; rc=$?; elapsed > "target/$f.at"; exit $rc ) &
+    pids+=($!)
+  done
+  for i in "${!pids[@]}"; do
+    f=${names[$i]}
+    if wait "${pids[$i]}"; then
+      printf '\n--- %s: passed (at %s)\n' "$f" "$(cat "target/$f.at")"
+    else
+      printf '\n--- %s: FAILED (at %s)\n' "$f" "$(cat "target/$f.at")"
+      failed+=("$f")
+    fi
+    cat "target/$f.out"
+  done
+  if [ ${#failed[@]} -gt 0 ]; then
+    echo "test.sh: failed: ${failed[*]} (above)" >&2
+    exit 1
+  fi
+}
+
 # Cargo's own CARGO_TARGET_DIR is followed (a build directory shared between checkouts keeps the
 # dependencies compiled).
 TARGET_DIR="${CARGO_TARGET_DIR:-target}"
@@ -85,38 +112,37 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
 fi
 
-step "cargo fmt --check"
-cargo fmt --all -- --check
+lints() {
+  cargo fmt --all -- --check
+  # With the test profile, clippy and `cargo test` below share the build scripts, their outputs
+  # (SQLite's C compiled once) and the procedural macros: about 50 s less on a cold build.
+  cargo clippy --workspace --all-targets --locked --profile test -- -D warnings
+}
 
-step "cargo clippy (warnings denied)"
-# With the test profile, clippy and `cargo test` below share the build scripts, their outputs
-# (SQLite's C compiled once) and the procedural macros: about 50 s less on a cold build.
-cargo clippy --workspace --all-targets --locked --profile test -- -D warnings
+viewer_tests() {
+  cd viewer
+  npx tsc --noEmit
+  npm test
+}
 
-mkdir -p target
-step "viewer: type check and unit tests (vitest)"
-(cd viewer && npx tsc --noEmit && npm test 2>&1) | tee target/vitest.log
-VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/vitest.log | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
+step "side by side: cargo fmt --check and cargo clippy, warnings denied (lints); the viewer's type check and unit tests (viewer_tests: tsc, vitest)"
+side_by_side lints viewer_tests
+VITEST=$(sed 's/\x1b\[[0-9;]*m//g' target/viewer_tests.out | awk '/^ *Tests +[0-9]+ passed/ { print $2 }' | tail -1)
 
 step "viewer: build (embedded into pmc by the next step)"
 (cd viewer && npm run --silent build)
 
-step "cargo test"
-# The tests' scratch files (std::env::temp_dir) go to a directory of the build's, emptied at each
-# run, rather than piling up in /tmp run after run.
-SCRATCH="$TARGET_DIR/test-scratch"
-rm -rf "$SCRATCH"
-mkdir -p "$SCRATCH"
+step "cargo test: the build"
 # pmc-bench holds the criterion benchmarks alone (no test; clippy above checks and lints them):
 # leaving it out of the test build spares compiling criterion and the reference crates the
 # benchmarks compare with (about a minute of one core).
-TMPDIR="$SCRATCH" cargo test --workspace --exclude pmc-bench --locked 2>&1 | tee target/cargo-test.log
-# The pmc binary the CLI's tests ran, built by `cargo test` with the test profile (optimised,
-# viewer/dist embedded): the exports and the end-to-end tests below use it too, so the suite
-# compiles the workspace once, not a second time for a release build.
+cargo test --workspace --exclude pmc-bench --locked --no-run
+# The pmc binary the CLI's tests run, built by `cargo test` with the test profile (optimised,
+# viewer/dist embedded): the Python tests, the exports and the end-to-end tests below use it too,
+# so the suite compiles the workspace once, not a second time for a release build.
 PMC="$TARGET_DIR/debug/pmc"
 
-step "Python package: the wheel (maturin) and its tests (pytest, a 2-worker Dask bake among them)"
+step "Python package: the wheel (maturin)"
 if ! wait "$VENV_JOB"; then
   cat "$TARGET_DIR/python-venv.log" >&2
   echo "test.sh: the Python virtual environment could not be made (above)" >&2
@@ -127,40 +153,61 @@ fi
 rm -rf "$TARGET_DIR/wheels"
 "$VENV/bin/maturin" build --quiet --locked --out "$TARGET_DIR/wheels" -m python/Cargo.toml
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$TARGET_DIR"/wheels/pmc-*.whl
-# From another directory, so that `import pmc` is the installed wheel, not the source folder.
-(cd "$TARGET_DIR" && PMC_BIN="$PMC" TMPDIR="$SCRATCH" "$VENV/bin/python" -m pytest "$OLDPWD/python/tests" -q -p no:cacheprovider 2>&1) | tee "$TARGET_DIR/pytest.log"
-PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' "$TARGET_DIR/pytest.log" | tail -1)
+
+# The tests' scratch files (std::env::temp_dir, tempfile) go to a directory of the build's,
+# emptied at each run, rather than piling up in /tmp run after run.
+SCRATCH="$TARGET_DIR/test-scratch"
+rm -rf "$SCRATCH"
+mkdir -p "$SCRATCH"
+
+rust_tests() {
+  TMPDIR="$SCRATCH" cargo test --workspace --exclude pmc-bench --locked
+}
+
+python_tests() {
+  # From another directory, so that `import pmc` is the installed wheel, not the source folder.
+  (cd "$TARGET_DIR" && PMC_BIN="$PMC" TMPDIR="$SCRATCH" "$VENV/bin/python" -m pytest "$OLDPWD/python/tests" -q -p no:cacheprovider)
+}
+
+OUT=target/test-artifacts
+exports() {
+  mkdir -p "$OUT"
+  "$PMC" generate --quiet --preset sphere --n-c 4 --n-t 16 -o "$OUT/sphere.glb"
+  "$PMC" generate --quiet --preset sphere --n-c 4 --n-t 16 -o "$OUT/sphere.ply"
+  "$PMC" generate --quiet --preset earthlike --seed 7 -o "$OUT/earthlike.glb"
+  "$PMC" generate --quiet --preset earthlike --seed 7 --n-c 4 -o "$OUT/earthlike.ply"
+  "$PMC" generate --quiet --preset moon --seed 3 --n-c 4 -o "$OUT/moon.glb"
+  "$PMC" generate --quiet --preset mars --seed 5 --n-c 4 -o "$OUT/mars.glb"
+  node tools/gltf-validate/validate.mjs "$OUT/sphere.glb" "$OUT/earthlike.glb" "$OUT/moon.glb" "$OUT/mars.glb"
+  # 3D Tiles: every tile content of a small planet's bake, by the same validator
+  rm -rf "$OUT/tiles"
+  "$PMC" tiles bake --quiet --preset moon --seed 3 --n-c 8 --n-t 16 -o "$OUT/tiles"
+  find "$OUT/tiles/content" -name '*.glb' -print0 | xargs -0 node tools/gltf-validate/validate.mjs > "$OUT/tiles-validate.log"
+  echo "gltf-validator: $(grep -c ': ok 0 errors' "$OUT/tiles-validate.log") tile contents valid"
+  # The bake's tileset JSON against the 3D Tiles 1.1 schemas, loaded by loaders.gl (prints its summary)
+  node tools/tiles-check/check.mjs "$OUT/tiles"
+
+  # The sphere preset's radius: d_b + T/2 + 0.37 l_d with T = l_d n_t d_c.
+  R=$(python3 -c "print(1744 + 4*16*2/2 + 0.37*4)")
+  V=$(python3 -c "import math; print(4/3*math.pi*$R**3)")
+  python3 tools/check_mesh.py "$OUT/sphere.ply" --expect-euler 2 --expect-volume "$V" --tolerance 0.005
+  python3 tools/check_mesh.py "$OUT/earthlike.ply"
+}
+
+if [ "$QUICK" = 1 ]; then
+  step "side by side: cargo test (rust_tests) and the Python package's tests (python_tests: pytest, a 2-worker Dask bake among them)"
+  side_by_side rust_tests python_tests
+else
+  step "side by side: cargo test (rust_tests), the Python package's tests (python_tests: pytest, a 2-worker Dask bake among them), and planets exported and validated (exports: Khronos glTF validator, loaders.gl, trimesh)"
+  side_by_side rust_tests python_tests exports
+fi
+PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' target/python_tests.out | tail -1)
 
 if [ "$QUICK" = 1 ]; then
   step "quick mode: exports, external validators and the end-to-end tests not run"
-  awk -v ext="$((${VITEST:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/cargo-test.log
+  awk -v ext="$((${VITEST:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/rust_tests.out
   exit 0
 fi
-
-OUT=target/test-artifacts
-mkdir -p "$OUT"
-
-step "export planets and validate them"
-"$PMC" generate --quiet --preset sphere --n-c 4 --n-t 16 -o "$OUT/sphere.glb"
-"$PMC" generate --quiet --preset sphere --n-c 4 --n-t 16 -o "$OUT/sphere.ply"
-"$PMC" generate --quiet --preset earthlike --seed 7 -o "$OUT/earthlike.glb"
-"$PMC" generate --quiet --preset earthlike --seed 7 --n-c 4 -o "$OUT/earthlike.ply"
-"$PMC" generate --quiet --preset moon --seed 3 --n-c 4 -o "$OUT/moon.glb"
-"$PMC" generate --quiet --preset mars --seed 5 --n-c 4 -o "$OUT/mars.glb"
-node tools/gltf-validate/validate.mjs "$OUT/sphere.glb" "$OUT/earthlike.glb" "$OUT/moon.glb" "$OUT/mars.glb"
-# 3D Tiles: every tile content of a small planet's bake, by the same validator
-rm -rf "$OUT/tiles"
-"$PMC" tiles bake --quiet --preset moon --seed 3 --n-c 8 --n-t 16 -o "$OUT/tiles"
-find "$OUT/tiles/content" -name '*.glb' -print0 | xargs -0 node tools/gltf-validate/validate.mjs > "$OUT/tiles-validate.log"
-echo "gltf-validator: $(grep -c ': ok 0 errors' "$OUT/tiles-validate.log") tile contents valid"
-# The bake's tileset JSON against the 3D Tiles 1.1 schemas, loaded by loaders.gl (prints its summary)
-node tools/tiles-check/check.mjs "$OUT/tiles"
-
-# The sphere preset's radius: d_b + T/2 + 0.37 l_d with T = l_d n_t d_c.
-R=$(python3 -c "print(1744 + 4*16*2/2 + 0.37*4)")
-V=$(python3 -c "import math; print(4/3*math.pi*$R**3)")
-python3 tools/check_mesh.py "$OUT/sphere.ply" --expect-euler 2 --expect-volume "$V" --tolerance 0.005
-python3 tools/check_mesh.py "$OUT/earthlike.ply"
 
 step "viewer: end-to-end tests in headless Chromium against pmc serve"
 (cd viewer && PMC_BIN="$PMC" node e2e/run.mjs 2>&1) | tee target/e2e.log
@@ -171,4 +218,4 @@ step "all checks passed"
 # any failure there has already stopped the script).
 EXTERNAL_CHECKS=5
 E2E=$(sed 's/\x1b\[[0-9;]*m//g' target/e2e.log | awk '/^e2e: [0-9]+ passed/ { print $2 }' | tail -1)
-awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/cargo-test.log
+awk -v ext="$((EXTERNAL_CHECKS + ${VITEST:-0} + ${E2E:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p + ext, f }' target/rust_tests.out
