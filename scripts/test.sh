@@ -160,11 +160,6 @@ SCRATCH="$TARGET_DIR/test-scratch"
 rm -rf "$SCRATCH"
 mkdir -p "$SCRATCH"
 
-# The number of Python tests passed (pytest's last line).
-pytest_count() {
-  awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' target/python_tests.out | tail -1
-}
-
 rust_tests() {
   TMPDIR="$SCRATCH" cargo test --workspace --exclude pmc-bench --locked
 }
@@ -202,34 +197,20 @@ exports() {
 if [ "$QUICK" = 1 ]; then
   step "side by side: cargo test (rust_tests) and the Python package's tests (python_tests: pytest, a 2-worker Dask bake among them)"
   side_by_side rust_tests python_tests
-  PYTEST=$(pytest_count)
+else
+  step "side by side: cargo test (rust_tests), the Python package's tests (python_tests: pytest, a 2-worker Dask bake among them), and planets exported and validated (exports: Khronos glTF validator, loaders.gl, trimesh)"
+  side_by_side rust_tests python_tests exports
+fi
+PYTEST=$(awk '/ passed/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^passed/) print $i }' target/python_tests.out | tail -1)
+
+if [ "$QUICK" = 1 ]; then
   step "quick mode: exports, external validators and the end-to-end tests not run"
   awk -v ext="$((${VITEST:-0} + ${PYTEST:-0}))" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed (quick)\n", p + ext, f }' target/rust_tests.out
   exit 0
 fi
 
-# The end-to-end tests (headless Chromium against pmc serve) begin now, beside the steps below,
-# in a process group of their own (stopped with the script); their soak, which compares the
-# times of its views, waits for the file $GATE, made when the other steps are done.
-GATE="$TARGET_DIR/e2e-others-done"
-rm -f "$GATE"
-e2e() {
-  cd viewer
-  PMC_BIN="$PMC" PMC_E2E_ALONE_AFTER="$GATE" exec setsid node e2e/run.mjs
-}
-e2e > target/e2e.log 2>&1 &
-E2E_JOB=$!
-trap 'kill -TERM -- "-$E2E_JOB" 2>/dev/null || true' EXIT
-
-step "side by side: cargo test (rust_tests), the Python package's tests (python_tests: pytest, a 2-worker Dask bake among them), planets exported and validated (exports: Khronos glTF validator, loaders.gl, trimesh), and the end-to-end tests begun (below)"
-side_by_side rust_tests python_tests exports
-PYTEST=$(pytest_count)
-touch "$GATE"
-
-step "viewer: end-to-end tests in headless Chromium against pmc serve (begun beside the steps above)"
-tail -n +1 -f --pid="$E2E_JOB" target/e2e.log
-wait "$E2E_JOB"
-trap - EXIT
+step "viewer: end-to-end tests in headless Chromium against pmc serve"
+(cd viewer && PMC_BIN="$PMC" node e2e/run.mjs 2>&1) | tee target/e2e.log
 
 step "all checks passed"
 # One closing line: the Rust suite's totals plus the external checks above (the validator run

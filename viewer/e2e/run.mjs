@@ -24,10 +24,6 @@
 //                   mode's, step 20, and the default planet's levels of detail, step 9, run in
 //                   browsers of their own beside the others; the soak, step 18, runs last and
 //                   alone)
-//   PMC_E2E_ALONE_AFTER  a file: the soak (step 18, which compares the times of its views) waits
-//                   until it exists, so that the steps before it may share the machine with other
-//                   work (scripts/test.sh runs the Rust and Python tests beside them and makes
-//                   the file when those are done)
 //   PMC_E2E_GL      llvmpipe or swiftshader: the software renderer of WebGL (by default Mesa's
 //                   llvmpipe where installed; the flights always draw with SwiftShader)
 //   PMC_E2E_SERVE_ARGS more options for every `pmc serve`, e.g. '--cache-mb 16' (a stall hunt)
@@ -41,7 +37,6 @@
 // and the browser are stopped in every case.
 
 import { existsSync, mkdirSync } from 'node:fs';
-import { setTimeout as sleep } from 'node:timers/promises';
 import { join } from 'node:path';
 import { openBrowser } from './browser.mjs';
 import { CHROMIUM, FLIGHTS_GL, GALLERY, GL, LAYOUT, TOTAL_MS, USE_MOCK, artifacts, cleanup, distDir, fail, log, results, selected, short, started, step } from './harness.mjs';
@@ -98,16 +93,6 @@ const FLIGHTS = new Set([lodEarth, elevationModel, lodDefault]);
 const LAST = [soak];
 const LANES = Number(process.env.PMC_E2E_LANES ?? 2);
 
-/** Waits until the file PMC_E2E_ALONE_AFTER names exists (at once when it is not set). */
-async function aloneOnTheMachine() {
-  const gate = process.env.PMC_E2E_ALONE_AFTER;
-  if (!gate || existsSync(gate)) return;
-  log(`waiting for ${gate} (the other work on the machine done) before the soak`);
-  const since = Date.now();
-  while (!existsSync(gate)) await sleep(250);
-  log(`the machine is ours: the soak begins after ${((Date.now() - since) / 1000).toFixed(1)} s of waiting`);
-}
-
 async function main() {
   if (!existsSync(join(distDir, 'index.html'))) throw new Error('viewer/dist is missing: run `npm run build` first');
   if (!existsSync(CHROMIUM)) throw new Error(`no browser at ${CHROMIUM} (install Debian's chromium or set CHROMIUM)`);
@@ -155,10 +140,7 @@ async function main() {
     await firstLane();
     await secondLane();
   }
-  if (!USE_MOCK && LAST.some((s) => selected(s.name))) {
-    await aloneOnTheMachine();
-    for (const s of LAST) await step(s.name, () => s.scenario(t));
-  }
+  if (!USE_MOCK) for (const s of LAST) await step(s.name, () => s.scenario(t));
   // the README's pictures: asked for (PMC_E2E_GALLERY=1, or PMC_E2E_ONLY naming step 16)
   if (GALLERY) await step(gallery.name, () => gallery.scenario(t));
 }
