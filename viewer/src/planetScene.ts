@@ -617,23 +617,35 @@ export class PlanetScene {
   }
 
   /**
-   * Up to `count` vertices of the chunks shown, spread evenly over them (test hook): where they
-   * are, their height and the lowest height of the triangles around them.
+   * Up to `count` vertices of the chunks shown, spread evenly over all of them (test hook): where
+   * they are, their height and the lowest height of the triangles around them. The same vertices
+   * whatever order the chunks arrived in: the chunks are taken in the order of their keys, and
+   * the k-th of `count` samples is the vertex at `k * total / count` of them all. (A whole-number
+   * stride of 1 when there were fewer than twice `count` vertices took the first `count` in
+   * arrival order, most of the view or little of it: "only 68 land places in view".)
    */
   sampleVertices(count: number): SampledVertex[] {
-    const objs = [...this.chunks.values()];
+    const objs = [...this.chunks.values()].sort((a, b) => (a.key < b.key ? -1 : a.key > b.key ? 1 : 0));
     const total = objs.reduce((n, o) => n + o.mesh.geometry.getAttribute('position').count, 0);
     const out: SampledVertex[] = [];
     if (total === 0 || count <= 0) return out;
-    const stride = Math.max(1, Math.floor(total / count));
+    const samples = Math.min(count, total);
+    const step = total / samples;
+    // the next sample's index among all vertices, and the vertices of the chunks before this one
+    let k = 0;
     let seen = 0;
     for (const o of objs) {
       const g = o.mesh.geometry;
       const pos = g.getAttribute('position');
+      const n = pos.count;
+      let next = Math.floor(k * step);
+      if (next >= seen + n) {
+        seen += n;
+        continue;
+      }
       const nrm = g.getAttribute('normal');
       const hgt = g.getAttribute('aHeight');
       const index = g.getIndex();
-      const n = pos.count;
       // the lowest height of the triangles around each vertex
       const ring = new Float64Array(n).fill(Infinity);
       if (index) {
@@ -648,8 +660,8 @@ export class PlanetScene {
           ring[c] = Math.min(ring[c]!, lo);
         }
       }
-      const first = (stride - (seen % stride)) % stride;
-      for (let i = first; i < n && out.length < count; i += stride) {
+      for (; k < samples && next < seen + n; k++, next = Math.floor(k * step)) {
+        const i = next - seen;
         if (ring[i] === Infinity) continue;
         const nx = nrm.getX(i);
         const ny = nrm.getY(i);
